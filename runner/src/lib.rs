@@ -1,0 +1,16 @@
+//! # runner
+//!
+//! The host side of splitsum: backends (wgpu GPU and native CPU) that run the
+//! `splitsum_shaders` functions, the files that go in and out, and the orchestration of
+//! bakes. It holds no BRDF or sampling math: that lives once, in `splitsum_shaders`.
+
+pub mod backend;
+pub mod cli;
+pub mod cpu;
+pub mod error;
+pub mod files;
+pub mod gpu;
+pub mod texture;
+
+pub use backend::{Backend, BackendKind};
+pub use error::{Error, Result};

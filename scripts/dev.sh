@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# splitsum's one entry point for people and CI. It installs what the project needs on a
+# fresh machine (the nightly rust-gpu is pinned to, and Mesa's lavapipe Vulkan driver so
+# the GPU backend runs without a GPU), then runs:
+#
+#   bash scripts/dev.sh run [ARGS...]   # the runner (no ARGS: the default bake and view)
+#   bash scripts/dev.sh test            # every test, optimised (the CPU path is slow in debug)
+#   bash scripts/dev.sh cargo ARGS...   # any cargo command with the pinned toolchain
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+TOOLCHAIN=nightly-2026-08-15
+
+ensure_toolchain() {
+    local have
+    have=$(rustup component list --toolchain "$TOOLCHAIN" --installed 2>/dev/null || true)
+    if ! grep -q '^rust-src' <<<"$have" || ! grep -q '^rustc-dev' <<<"$have" || ! grep -q '^llvm-tools' <<<"$have"; then
+        echo "dev.sh: installing $TOOLCHAIN with rust-src, rustc-dev, llvm-tools (rust-gpu needs exactly this nightly)" >&2
+        rustup toolchain install "$TOOLCHAIN" --profile minimal -c rust-src -c rustc-dev -c llvm-tools >&2
+    fi
+}
+
+as_root() {
+    if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else
+        echo "dev.sh: need root to run: $*" >&2; return 1
+    fi
+}
+
+ensure_vulkan() {
+    if ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1 && ldconfig -p | grep -q 'libvulkan.so.1'; then
+        return
+    fi
+    if command -v apt-get >/dev/null; then
+        echo "dev.sh: installing Mesa's Vulkan drivers (lavapipe runs the GPU backend on the CPU)" >&2
+        as_root apt-get update -qq >&2 || true
+        as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >&2
+    else
+        echo "dev.sh: no Vulkan driver found and no apt-get; install Mesa's lavapipe (mesa-vulkan-drivers) yourself, or use --backend cpu" >&2
+    fi
+}
+
+# Quiet libwayland's complaint when wgpu probes for a display on a headless machine.
+if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
+    export XDG_RUNTIME_DIR="${TMPDIR:-/tmp}/splitsum-xdg-$(id -u)"
+    mkdir -p -m 700 "$XDG_RUNTIME_DIR"
+fi
+
+cmd=${1:-run}
+[ $# -gt 0 ] && shift
+ensure_toolchain
+case "$cmd" in
+    run)
+        ensure_vulkan
+        exec cargo +"$TOOLCHAIN" run --release -p runner -- "$@"
+        ;;
+    test)
+        ensure_vulkan
+        exec cargo +"$TOOLCHAIN" test --release --workspace "$@"
+        ;;
+    cargo)
+        exec cargo +"$TOOLCHAIN" "$@"
+        ;;
+    *)
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS..." >&2
+        exit 2
+        ;;
+esac

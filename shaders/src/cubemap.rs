@@ -1,0 +1,265 @@
+//! Cube maps stored in a plain buffer, with software filtering that the CPU reproduces
+//! bit for bit.
+//!
+//! **Faces and orientation** follow Vulkan/OpenGL (OpenGL 4.6 §8.13, Table 8.19) and KTX2:
+//! faces `+X, −X, +Y, −Y, +Z, −Z`; for a direction with major axis `m`, the face
+//! coordinates are `u = (s_c/|m| + 1)/2`, `v = (t_c/|m| + 1)/2`, and row 0 of a face is
+//! `v = 0`.
+//!
+//! **Storage**: RGBA f32 texels (`Vec4`), mip levels one after the other, each level six
+//! faces of `sᵢ × sᵢ` texels in row-major order, `sᵢ = max(1, s₀ >> i)` ([`CubeLayout`]).
+//!
+//! **Filtering**: bilinear within a face; taps that fall off the face are re-projected onto
+//! the neighbouring face (the texel whose centre the extrapolated texel centre projects
+//! into), and the missing fourth tap at a cube corner is dropped with the weights
+//! renormalised, i.e. the corner value is the weighted mean of the three texels that meet
+//! there (the "seamless" filtering of ARB_seamless_cube_map and of AMD CubeMapGen).
+//! Trilinear filtering blends two such levels.
+//!
+//! **Solid angle** of a texel: the exact area of its spherical quad, as two spherical
+//! triangles by Van Oosterom & Strackee's formula
+//! `tan(Ω/2) = |a·(b×c)| / (|a||b||c| + (a·b)|c| + (a·c)|b| + (b·c)|a|)` (IEEE Trans.
+//! Biomed. Eng. 30(2), 1983). On the face plane `z = 1` the triple product of a texel
+//! triangle is exactly `Δ²` (`Δ = 2/s`), so the formula has no cancellation even for tiny
+//! texels.
+
+use crate::math;
+use spirv_std::glam::{Vec2, Vec3, Vec4};
+
+/// Number of faces of a cube map.
+pub const FACES: u32 = 6;
+
+/// Size and mip count of a cube map stored level after level in a buffer.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub struct CubeLayout {
+    /// Face size of level 0, in texels.
+    pub size: u32,
+    /// Number of mip levels stored.
+    pub levels: u32,
+}
+
+impl CubeLayout {
+    /// A layout of `levels` mips starting at `size`×`size` faces.
+    pub const fn new(size: u32, levels: u32) -> Self {
+        Self { size, levels }
+    }
+
+    /// The number of levels of a full mip chain down to 1×1 for face size `size`.
+    pub fn full_chain(size: u32) -> u32 {
+        32 - size.max(1).leading_zeros()
+    }
+
+    /// Face size of level `level`: `max(1, size >> level)`.
+    #[inline]
+    pub fn level_size(&self, level: u32) -> u32 {
+        let s = self.size >> level;
+        if s == 0 { 1 } else { s }
+    }
+
+    /// Index of the first texel of level `level`.
+    #[inline]
+    pub fn level_offset(&self, level: u32) -> u32 {
+        let mut offset = 0;
+        let mut i = 0;
+        while i < level {
+            let s = self.level_size(i);
+            offset += FACES * s * s;
+            i += 1;
+        }
+        offset
+    }
+
+    /// Number of texels in all levels.
+    #[inline]
+    pub fn texel_count(&self) -> u32 {
+        self.level_offset(self.levels)
+    }
+
+    /// Index of texel `(x, y)` of `face` in `level`.
+    #[inline]
+    pub fn index(&self, level: u32, face: u32, x: u32, y: u32) -> u32 {
+        let s = self.level_size(level);
+        self.level_offset(level) + (face * s + y) * s + x
+    }
+}
+
+/// The face of the major axis of `d` and the face coordinates `(u, v)` ∈ [0, 1]².
+///
+/// Ties (edges and corners) go to `x` before `y` before `z`, so every direction has one
+/// face on every backend. The zero vector maps to the centre of face `+X`.
+#[inline]
+pub fn dir_to_face_uv(d: Vec3) -> (u32, Vec2) {
+    let ax = math::abs(d.x);
+    let ay = math::abs(d.y);
+    let az = math::abs(d.z);
+    let (face, ma, sc, tc) = if ax >= ay && ax >= az {
+        if d.x >= 0.0 { (0, ax, -d.z, -d.y) } else { (1, ax, d.z, -d.y) }
+    } else if ay >= az {
+        if d.y >= 0.0 { (2, ay, d.x, d.z) } else { (3, ay, d.x, -d.z) }
+    } else if d.z >= 0.0 {
+        (4, az, d.x, -d.y)
+    } else {
+        (5, az, -d.x, -d.y)
+    };
+    if !(ma > 0.0) {
+        return (0, Vec2::splat(0.5));
+    }
+    let inv = 0.5 / ma;
+    (face, Vec2::new(sc * inv + 0.5, tc * inv + 0.5))
+}
+
+/// The point of face `face` at face coordinates `uv`, on the unit cube (not normalised).
+#[inline]
+pub fn face_uv_to_cube(face: u32, uv: Vec2) -> Vec3 {
+    let a = 2.0 * uv.x - 1.0;
+    let b = 2.0 * uv.y - 1.0;
+    match face {
+        0 => Vec3::new(1.0, -b, -a),
+        1 => Vec3::new(-1.0, -b, a),
+        2 => Vec3::new(a, 1.0, b),
+        3 => Vec3::new(a, -1.0, -b),
+        4 => Vec3::new(a, -b, 1.0),
+        _ => Vec3::new(-a, -b, -1.0),
+    }
+}
+
+/// The unit direction through face coordinates `uv` of `face`.
+#[inline]
+pub fn face_uv_to_dir(face: u32, uv: Vec2) -> Vec3 {
+    let p = face_uv_to_cube(face, uv);
+    p * (1.0 / math::sqrt(p.dot(p)))
+}
+
+/// The unit direction through the centre of texel `(x, y)` of a `size`×`size` face.
+#[inline]
+pub fn texel_dir(face: u32, x: u32, y: u32, size: u32) -> Vec3 {
+    let s = size as f32;
+    face_uv_to_dir(face, Vec2::new((x as f32 + 0.5) / s, (y as f32 + 0.5) / s))
+}
+
+/// Solid angle subtended at the origin by triangle `a, b, c` on the plane `z = 1`, whose
+/// triple product `a·(b×c)` is `triple` (Van Oosterom & Strackee 1983).
+#[inline]
+fn plane_triangle_solid_angle(a: Vec3, b: Vec3, c: Vec3, triple: f32) -> f32 {
+    let la = math::sqrt(a.dot(a));
+    let lb = math::sqrt(b.dot(b));
+    let lc = math::sqrt(c.dot(c));
+    let den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
+    2.0 * math::atan2(triple, den)
+}
+
+/// Exact solid angle (steradians) of texel `(x, y)` of a `size`×`size` cube face.
+/// Summed over the six faces it is 4π to f32 rounding.
+#[inline]
+pub fn texel_solid_angle(x: u32, y: u32, size: u32) -> f32 {
+    let d = 2.0 / size as f32;
+    let x0 = x as f32 * d - 1.0;
+    let y0 = y as f32 * d - 1.0;
+    let x1 = x0 + d;
+    let y1 = y0 + d;
+    let p00 = Vec3::new(x0, y0, 1.0);
+    let p10 = Vec3::new(x1, y0, 1.0);
+    let p11 = Vec3::new(x1, y1, 1.0);
+    let p01 = Vec3::new(x0, y1, 1.0);
+    let t = d * d; // a·(b×c) of both triangles, exactly
+    plane_triangle_solid_angle(p00, p10, p11, t) + plane_triangle_solid_angle(p00, p11, p01, t)
+}
+
+/// The texel of level `level` whose face square contains direction `d` (nearest texel).
+#[inline]
+pub fn texel_of_dir(layout: CubeLayout, level: u32, d: Vec3) -> u32 {
+    let s = layout.level_size(level);
+    let (face, uv) = dir_to_face_uv(d);
+    let sf = s as f32;
+    let x = math::clamp(math::floor(uv.x * sf), 0.0, sf - 1.0) as u32;
+    let y = math::clamp(math::floor(uv.y * sf), 0.0, sf - 1.0) as u32;
+    layout.index(level, face, x, y)
+}
+
+/// Index of the texel that tap `(x, y)` of `face` reads, where `x` or `y` may be one texel
+/// off the face: such a tap is re-projected onto the neighbouring face.
+#[inline]
+fn tap_index(layout: CubeLayout, level: u32, face: u32, x: i32, y: i32, s: u32) -> u32 {
+    let si = s as i32;
+    if x >= 0 && x < si && y >= 0 && y < si {
+        layout.index(level, face, x as u32, y as u32)
+    } else {
+        let sf = s as f32;
+        let uv = Vec2::new((x as f32 + 0.5) / sf, (y as f32 + 0.5) / sf);
+        texel_of_dir(layout, level, face_uv_to_cube(face, uv))
+    }
+}
+
+/// Seamless bilinear lookup of level `level` in direction `d` (need not be unit length).
+pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3) -> Vec4 {
+    let s = layout.level_size(level);
+    let (face, uv) = dir_to_face_uv(d);
+    let sf = s as f32;
+    let fx = uv.x * sf - 0.5;
+    let fy = uv.y * sf - 0.5;
+    let x0f = math::floor(fx);
+    let y0f = math::floor(fy);
+    let tx = fx - x0f;
+    let ty = fy - y0f;
+    let x0 = x0f as i32;
+    let y0 = y0f as i32;
+    let si = s as i32;
+    let mut acc = Vec4::ZERO;
+    let mut wsum = 0.0;
+    // The four taps; one that is off the face in both axes (a cube corner) is dropped.
+    let mut k = 0;
+    while k < 4 {
+        let dx = (k & 1) as i32;
+        let dy = (k >> 1) as i32;
+        let x = x0 + dx;
+        let y = y0 + dy;
+        let wx = if dx == 0 { 1.0 - tx } else { tx };
+        let wy = if dy == 0 { 1.0 - ty } else { ty };
+        let w = wx * wy;
+        let x_in = x >= 0 && x < si;
+        let y_in = y >= 0 && y < si;
+        if x_in || y_in {
+            acc += texels[tap_index(layout, level, face, x, y, s) as usize] * w;
+            wsum += w;
+        }
+        k += 1;
+    }
+    acc * (1.0 / wsum)
+}
+
+/// Seamless trilinear lookup at fractional level `lod`, clamped to the stored levels.
+pub fn sample_lod(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) -> Vec4 {
+    let max_lod = (layout.levels - 1) as f32;
+    let l = math::clamp(lod, 0.0, max_lod);
+    let l0 = math::floor(l);
+    let t = l - l0;
+    let m0 = l0 as u32;
+    let a = sample_bilinear(texels, layout, m0, d);
+    if t > 0.0 && m0 + 1 < layout.levels {
+        let b = sample_bilinear(texels, layout, m0 + 1, d);
+        a * (1.0 - t) + b * t
+    } else {
+        a
+    }
+}
+
+/// Texel `(x, y)` of `face` in level `level + 1` from the 2×2 texels it covers in
+/// `level`, each weighted by its solid angle (an area-correct box filter).
+pub fn downsample_texel(texels: &[Vec4], layout: CubeLayout, level: u32, face: u32, x: u32, y: u32) -> Vec4 {
+    let s = layout.level_size(level);
+    if s == 1 {
+        return texels[layout.index(level, face, 0, 0) as usize];
+    }
+    let mut acc = Vec4::ZERO;
+    let mut wsum = 0.0;
+    let mut k = 0;
+    while k < 4 {
+        let cx = 2 * x + (k & 1);
+        let cy = 2 * y + (k >> 1);
+        let w = texel_solid_angle(cx, cy, s);
+        acc += texels[layout.index(level, face, cx, cy) as usize] * w;
+        wsum += w;
+        k += 1;
+    }
+    acc * (1.0 / wsum)
+}

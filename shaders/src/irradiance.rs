@@ -1,0 +1,107 @@
+//! Diffuse irradiance: the cosine convolution of the environment, as a small cube map and
+//! as nine spherical-harmonic coefficients.
+//!
+//! **Convention**: stored values are irradiance divided by π, `E(n)/π = (1/π)∫ L(l) max(0, n·l) dl`,
+//! the cosine-weighted mean radiance. A Lambert surface of albedo ρ under it reflects
+//! `ρ·E/π`, and a constant environment `L` gives exactly `L`.
+//!
+//! **Convolution** (the brute-force sum of LearnOpenGL "Diffuse irradiance", without its
+//! sampling noise): `E/π = Σⱼ Lⱼ wⱼ / Σⱼ wⱼ`, `wⱼ = max(0, n·ωⱼ) Ωⱼ`, over every texel `j` of
+//! one level of the source cube (`Ωⱼ` its exact solid angle). The normalisation by `Σ wⱼ`
+//! (≈ π) makes a constant environment exact.
+//!
+//! **Spherical harmonics** (Ramamoorthi & Hanrahan 2001, "An Efficient Representation
+//! for Irradiance Environment Maps", eq. 7–8; real basis of Sloan 2008, "Stupid Spherical
+//! Harmonics Tricks", appendix A2): radiance coefficients `L_lm = Σⱼ Lⱼ Y_lm(ωⱼ) Ωⱼ`, and
+//! `E(n)/π = Σ (Âₗ/π) L_lm Y_lm(n)` with `Âₗ/π = 1, 2/3, 1/4` for `l = 0, 1, 2`.
+
+use crate::cubemap::{self, CubeLayout};
+use crate::math::{CompensatedSum, CompensatedSum4};
+use spirv_std::glam::{Vec3, Vec4};
+
+/// Number of SH coefficients up to band 2.
+pub const SH9: usize = 9;
+
+/// The nine real SH basis functions `Y_lm` at unit direction `d`, ordered
+/// `(0,0), (1,−1), (1,0), (1,1), (2,−2), (2,−1), (2,0), (2,1), (2,2)`.
+#[inline]
+pub fn sh9_basis(d: Vec3) -> [f32; SH9] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [
+        0.282_094_8,
+        0.488_602_5 * y,
+        0.488_602_5 * z,
+        0.488_602_5 * x,
+        1.092_548_4 * x * y,
+        1.092_548_4 * y * z,
+        0.315_391_57 * (3.0 * z * z - 1.0),
+        1.092_548_4 * x * z,
+        0.546_274_2 * (x * x - y * y),
+    ]
+}
+
+/// Cosine-lobe convolution factors `Âₗ/π` per coefficient.
+pub const SH9_COSINE: [f32; SH9] = [1.0, 2.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0, 0.25, 0.25, 0.25, 0.25, 0.25];
+
+/// `E(n)/π` from radiance coefficients `coeffs` (RGB in `xyz`).
+#[inline]
+pub fn sh9_irradiance(coeffs: &[Vec4; SH9], n: Vec3) -> Vec3 {
+    let y = sh9_basis(n);
+    let mut e = Vec3::ZERO;
+    let mut k = 0;
+    while k < SH9 {
+        e += coeffs[k].truncate() * (SH9_COSINE[k] * y[k]);
+        k += 1;
+    }
+    e
+}
+
+/// `E(n)/π` at unit normal `n` by the exact cosine-weighted sum over every texel of
+/// `level` of the source cube.
+pub fn convolve_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3) -> Vec4 {
+    let s = layout.level_size(level);
+    let mut acc = CompensatedSum4::new();
+    let mut wsum = CompensatedSum::new();
+    let mut face = 0;
+    while face < cubemap::FACES {
+        let mut y = 0;
+        while y < s {
+            let mut x = 0;
+            while x < s {
+                let c = n.dot(cubemap::texel_dir(face, x, y, s));
+                if c > 0.0 {
+                    let w = c * cubemap::texel_solid_angle(x, y, s);
+                    acc.add(src[layout.index(level, face, x, y) as usize] * w);
+                    wsum.add(w);
+                }
+                x += 1;
+            }
+            y += 1;
+        }
+        face += 1;
+    }
+    acc.total() * (1.0 / wsum.total())
+}
+
+/// The contribution of row `y` of `face` of `level` to the SH projection: nine RGB
+/// coefficient partial sums, then the row's total solid angle in `[SH9].x` (the host adds
+/// the rows in f64 and rescales so that the solid angles sum to exactly 4π).
+pub fn sh9_row(src: &[Vec4], layout: CubeLayout, level: u32, face: u32, y: u32) -> [Vec4; SH9 + 1] {
+    let s = layout.level_size(level);
+    let mut out = [Vec4::ZERO; SH9 + 1];
+    let mut x = 0;
+    while x < s {
+        let d = cubemap::texel_dir(face, x, y, s);
+        let w = cubemap::texel_solid_angle(x, y, s);
+        let l = src[layout.index(level, face, x, y) as usize] * w;
+        let basis = sh9_basis(d);
+        let mut k = 0;
+        while k < SH9 {
+            out[k] += l * basis[k];
+            k += 1;
+        }
+        out[SH9].x += w;
+        x += 1;
+    }
+    out
+}

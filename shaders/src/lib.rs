@@ -1,0 +1,26 @@
+//! # splitsum-shaders
+//!
+//! The math of split-sum image-based lighting, written once. rust-gpu compiles this crate
+//! to SPIR-V compute kernels (see [`kernels`]); the same functions compile natively, where
+//! the CPU backend and the tests call them. Every texture read that must agree between
+//! the two goes through code here (cube maps live in plain buffers and are filtered in
+//! software by [`cubemap`]), never through a hardware sampler.
+//!
+//! Data flow: an equirect environment ([`equirect`]) is resampled to a cube and its mip
+//! chain ([`cubemap`]); from it come the GGX-prefiltered specular cube ([`prefilter`]),
+//! the diffuse irradiance ([`irradiance`]); the BRDF table ([`lut`]) needs no environment.
+//! [`brdf`] holds the reflectance models, [`sampling`] the sample generators and [`math`]
+//! the elementary functions both backends evaluate identically.
+#![no_std]
+
+pub mod brdf;
+pub mod cubemap;
+pub mod equirect;
+pub mod irradiance;
+pub mod kernels;
+pub mod lut;
+pub mod math;
+pub mod prefilter;
+pub mod sampling;
+
+pub use spirv_std::glam;

@@ -1,0 +1,284 @@
+//! Elementary functions written once, so that the CPU and the GPU run the same arithmetic.
+//!
+//! Vulkan leaves the precision of `sin`, `cos`, `exp2`, `log2` and `pow` to the driver
+//! (Vulkan 1.3 spec, "Precision and Operation of SPIR-V Instructions": sin/cos only to an
+//! absolute 2⁻¹¹ on [−π, π], exp2/log2 to 3 + 2|x| ULP), and drivers differ: Mesa's
+//! lavapipe uses its own polynomials, NVIDIA its special-function unit. Those functions
+//! are therefore implemented here from additions, multiplications, `floor` and `sqrt`
+//! (which IEEE 754 and Vulkan both require to be correctly rounded), so a bake agrees
+//! between backends to a few ULP instead of to 2⁻¹¹.
+//!
+//! Methods (all f32, all branch-light so they suit SIMT hardware):
+//! - [`sin_cos_turns`]: exact Cody–Waite style reduction in *turns* (t·2π), where the
+//!   reduction by quarter turns is exact in binary, then Taylor polynomials on |x| ≤ π/4
+//!   (truncation below 3·10⁻⁹, under half an ULP).
+//! - [`atan2`]: octant reduction and the Cephes `atanf` minimax polynomial on
+//!   |z| ≤ tan(π/8) (relative error about 2·10⁻⁷).
+//! - [`exp2`], [`log2`]: exponent/mantissa split by bit manipulation, Taylor series of
+//!   e^(f·ln2) on |f| ≤ ½ and of 2·atanh((m−1)/(m+1)) on m ∈ [√½, √2].
+
+use spirv_std::glam::Vec4;
+use spirv_std::num_traits::Float;
+
+/// π in f32.
+pub const PI: f32 = core::f32::consts::PI;
+/// 1/π in f32.
+pub const FRAC_1_PI: f32 = core::f32::consts::FRAC_1_PI;
+/// 2π in f32.
+pub const TAU: f32 = core::f32::consts::TAU;
+
+// Taylor coefficients of sin(2πf) and cos(2πf) in powers of f, (2π)^k / k! with signs.
+const S1: f32 = 6.283_185_307_179_586;
+const S3: f32 = -41.341_702_240_399_76;
+const S5: f32 = 81.605_249_276_075_04;
+const S7: f32 = -76.705_859_753_061_4;
+const S9: f32 = 42.058_693_944_897_65;
+const C2: f32 = -19.739_208_802_178_716;
+const C4: f32 = 64.939_394_022_668_29;
+const C6: f32 = -85.456_817_206_693_72;
+const C8: f32 = 60.244_641_371_876_66;
+const C10: f32 = -26.426_256_783_374_39;
+
+/// √x, correctly rounded on both backends (IEEE 754; Vulkan's OpExtInst Sqrt).
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    Float::sqrt(x)
+}
+
+/// ⌊x⌋ (exact on both backends).
+#[inline]
+pub fn floor(x: f32) -> f32 {
+    Float::floor(x)
+}
+
+/// |x|.
+#[inline]
+pub fn abs(x: f32) -> f32 {
+    Float::abs(x)
+}
+
+/// The smaller of `a` and `b`; `b` if either is NaN (the same on every backend, unlike `fmin`).
+#[inline]
+pub fn min(a: f32, b: f32) -> f32 {
+    if a < b { a } else { b }
+}
+
+/// The larger of `a` and `b`; `b` if either is NaN (the same on every backend, unlike `fmax`).
+#[inline]
+pub fn max(a: f32, b: f32) -> f32 {
+    if a > b { a } else { b }
+}
+
+/// `x` clamped to `[lo, hi]`; NaN becomes `lo`.
+#[inline]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if x > lo {
+        if x < hi { x } else { hi }
+    } else {
+        lo
+    }
+}
+
+/// `(sin 2πt, cos 2πt)` for any finite `t` (an angle in turns).
+///
+/// The reduction `t − ⌊t + ½⌋` and the quarter-turn split are exact in binary floating
+/// point (Sterbenz), so only the polynomial rounds.
+#[inline]
+pub fn sin_cos_turns(t: f32) -> (f32, f32) {
+    let r = t - floor(t + 0.5); // r ∈ [−½, ½], exact
+    let q = floor(r * 4.0 + 0.5); // quadrant ∈ {−2, …, 2}
+    let f = r - q * 0.25; // f ∈ [−⅛, ⅛], exact
+    let f2 = f * f;
+    let s = f * (S1 + f2 * (S3 + f2 * (S5 + f2 * (S7 + f2 * S9))));
+    let c = 1.0 + f2 * (C2 + f2 * (C4 + f2 * (C6 + f2 * (C8 + f2 * C10))));
+    match (q as i32) & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
+}
+
+/// `(sin x, cos x)` for an angle `x` in radians.
+#[inline]
+pub fn sin_cos(x: f32) -> (f32, f32) {
+    sin_cos_turns(x * (0.5 * FRAC_1_PI))
+}
+
+/// Four-quadrant arctangent of `y/x` in radians, in [−π, π]; `atan2(0, 0) = 0`.
+#[inline]
+pub fn atan2(y: f32, x: f32) -> f32 {
+    let ax = abs(x);
+    let ay = abs(y);
+    let hi = if ax > ay { ax } else { ay };
+    let lo = if ax > ay { ay } else { ax };
+    if hi == 0.0 {
+        return 0.0;
+    }
+    let a = lo / hi; // a ∈ [0, 1]
+    // atan(a) = π/4 + atan((a − 1)/(a + 1)) brings the argument to |z| ≤ tan(π/8).
+    let big = a > 0.414_213_57;
+    let z = if big { (a - 1.0) / (a + 1.0) } else { a };
+    let z2 = z * z;
+    let p = ((8.053_744_5e-2 * z2 - 1.387_768_6e-1) * z2 + 1.997_771_1e-1) * z2 - 3.333_295e-1;
+    let mut r = z + z * z2 * p;
+    if big {
+        r += core::f32::consts::FRAC_PI_4;
+    }
+    if ay > ax {
+        r = core::f32::consts::FRAC_PI_2 - r;
+    }
+    if x < 0.0 {
+        r = PI - r;
+    }
+    if y < 0.0 { -r } else { r }
+}
+
+/// 2^x, exact at integers; `0` below the subnormal range. For `x ≥ 128` it saturates to
+/// `f32::MAX` rather than overflowing (and naga rejects infinite constants in shaders).
+#[inline]
+pub fn exp2(x: f32) -> f32 {
+    if x >= 128.0 {
+        return f32::MAX;
+    }
+    if x < -150.0 {
+        return 0.0;
+    }
+    let n = floor(x + 0.5);
+    let f = x - n; // f ∈ [−½, ½], exact
+    let g = f * core::f32::consts::LN_2;
+    // e^g, Taylor to degree 7 (truncation < 6·10⁻⁹ relative on |g| ≤ ln2/2).
+    let p = 1.0
+        + g * (1.0
+            + g * (0.5
+                + g * (1.666_666_7e-1
+                    + g * (4.166_666_6e-2
+                        + g * (8.333_333e-3 + g * (1.388_888_9e-3 + g * 1.984_127e-4))))));
+    let ni = n as i32;
+    if ni >= -126 {
+        p * f32::from_bits(((ni + 127) as u32) << 23)
+    } else {
+        // Subnormal result: scale in two exact steps.
+        p * f32::from_bits(((ni + 127 + 64) as u32) << 23) * f32::from_bits(((127 - 64) as u32) << 23)
+    }
+}
+
+/// log₂ x for `x > 0`, subnormals included. Outside that domain it saturates instead of
+/// returning ±∞ or NaN (naga rejects such constants in shaders): `x ≤ 0` and NaN give
+/// [`LOG2_FLOOR`], `x = +∞` gives 128.
+#[inline]
+pub fn log2(x: f32) -> f32 {
+    if !(x > 0.0) {
+        return LOG2_FLOOR;
+    }
+    if x > f32::MAX {
+        return 128.0;
+    }
+    let mut bits = x.to_bits();
+    let mut e: i32 = 0;
+    if bits < 0x0080_0000 {
+        // Subnormal: multiply by 2²³ (exact) first.
+        bits = (x * 8_388_608.0).to_bits();
+        e = -23;
+    }
+    e += ((bits >> 23) as i32) - 127;
+    let mut m = f32::from_bits((bits & 0x007f_ffff) | 0x3f80_0000); // m ∈ [1, 2)
+    if m > core::f32::consts::SQRT_2 {
+        m *= 0.5;
+        e += 1;
+    }
+    // log₂ m = (2/ln2)·atanh(z), z = (m−1)/(m+1) ∈ [−0.172, 0.172]; series to z⁹.
+    let z = (m - 1.0) / (m + 1.0);
+    let z2 = z * z;
+    let s = z * (2.0 + z2 * (0.666_666_7 + z2 * (0.4 + z2 * (0.285_714_3 + z2 * 0.222_222_22))));
+    e as f32 + s * core::f32::consts::LOG2_E
+}
+
+/// What [`log2`] returns for `x ≤ 0`: below log₂ of the smallest subnormal (−149).
+pub const LOG2_FLOOR: f32 = -150.0;
+
+/// x^y for `x ≥ 0` as exp2(y·log2 x), with `0^y = 0` for `y > 0` and `x^0 = 1`.
+#[inline]
+pub fn pow(x: f32, y: f32) -> f32 {
+    if y == 0.0 {
+        return 1.0;
+    }
+    if x <= 0.0 {
+        return 0.0;
+    }
+    exp2(y * log2(x))
+}
+
+/// x⁵ by multiplication (Schlick's Fresnel term).
+#[inline]
+pub fn pow5(x: f32) -> f32 {
+    let x2 = x * x;
+    x2 * x2 * x
+}
+
+/// Clamps to [0, 1]; NaN becomes 0.
+#[inline]
+pub fn saturate(x: f32) -> f32 {
+    clamp(x, 0.0, 1.0)
+}
+
+/// Kahan's compensated summation: the sum of 2²⁴ and more f32 terms without the O(N·ε)
+/// drift of naive accumulation (Kahan 1965, "Further remarks on reducing truncation
+/// errors"; Higham, *Accuracy and Stability of Numerical Algorithms* §4.3). Branch-free,
+/// so it costs the GPU no divergence.
+#[derive(Copy, Clone, Default)]
+pub struct CompensatedSum {
+    sum: f32,
+    carry: f32,
+}
+
+impl CompensatedSum {
+    /// An empty sum.
+    pub fn new() -> Self {
+        Self { sum: 0.0, carry: 0.0 }
+    }
+
+    /// Adds `x`.
+    #[inline]
+    pub fn add(&mut self, x: f32) {
+        let y = x - self.carry;
+        let t = self.sum + y;
+        self.carry = (t - self.sum) - y;
+        self.sum = t;
+    }
+
+    /// The compensated total.
+    #[inline]
+    pub fn total(&self) -> f32 {
+        self.sum
+    }
+}
+
+/// [`CompensatedSum`] for four channels at once.
+#[derive(Copy, Clone, Default)]
+pub struct CompensatedSum4 {
+    sum: Vec4,
+    carry: Vec4,
+}
+
+impl CompensatedSum4 {
+    /// An empty sum.
+    pub fn new() -> Self {
+        Self { sum: Vec4::ZERO, carry: Vec4::ZERO }
+    }
+
+    /// Adds `x`.
+    #[inline]
+    pub fn add(&mut self, x: Vec4) {
+        let y = x - self.carry;
+        let t = self.sum + y;
+        self.carry = (t - self.sum) - y;
+        self.sum = t;
+    }
+
+    /// The compensated total.
+    #[inline]
+    pub fn total(&self) -> Vec4 {
+        self.sum
+    }
+}

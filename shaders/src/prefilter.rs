@@ -1,0 +1,122 @@
+//! GGX-prefiltered specular radiance, one roughness per mip (Karis 2013, "Real Shading in
+//! Unreal Engine 4", eq. 7 and `PrefilterEnvMap`; LearnOpenGL "Specular IBL").
+//!
+//! The first sum of the split-sum approximation, with `n = v = r` (the lobe is assumed
+//! isotropic about the reflection direction):
+//!
+//! `L̃(r) = Σ L(lₖ)(n·lₖ) / Σ (n·lₖ)`, `hₖ ~ D(h)(n·h)`, `lₖ = reflect(v, hₖ)`.
+//!
+//! **Source-mip selection against fireflies** (Colbert & Křivánek 2007, GPU Gems 3 ch. 20,
+//! "filtered importance sampling"; Filament `cmgen`): each sample reads the source cube at
+//! `lod = ½·log₂(Ωₛ/Ωₚ) + bias`, where `Ωₛ = 1/(N·pdf(l))` is the solid angle the sample
+//! stands for and `Ωₚ = 4π/(6s²)` the mean solid angle of a source texel. With `n = v`,
+//! `pdf(l) = D(h)(n·h)/(4 v·h) = D(h)/4`. A sun one texel wide is then seen through a
+//! filter as wide as the sample spacing instead of being hit or missed.
+//!
+//! **Roughness 0** is a mirror: the result is the source itself (copied exactly where the
+//! output level has the source's resolution).
+
+use crate::brdf::{alpha_from_roughness, microfacet};
+use crate::cubemap::{self, CubeLayout};
+use crate::math;
+use crate::sampling;
+use spirv_std::glam::{Vec3, Vec4};
+
+/// How the mips of the prefiltered cube map to roughness.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum RoughnessMapping {
+    /// `r = m / (M − 1)` (UE4, LearnOpenGL).
+    Linear = 0,
+    /// `r = (m / (M − 1))²`: more mips at low roughness, where the lobe changes fastest.
+    Quadratic = 1,
+}
+
+impl RoughnessMapping {
+    /// The mapping encoded as `u32` in kernel parameters; unknown codes are linear.
+    pub fn from_u32(code: u32) -> Self {
+        if code == 1 { Self::Quadratic } else { Self::Linear }
+    }
+
+    /// Roughness of mip `mip` out of `mips`.
+    #[inline]
+    pub fn roughness(self, mip: u32, mips: u32) -> f32 {
+        if mips <= 1 {
+            return 0.0;
+        }
+        let t = mip as f32 / (mips - 1) as f32;
+        match self {
+            Self::Linear => t,
+            Self::Quadratic => t * t,
+        }
+    }
+
+    /// The fractional mip holding roughness `roughness`, for trilinear lookup.
+    #[inline]
+    pub fn lod(self, roughness: f32, mips: u32) -> f32 {
+        let r = math::saturate(roughness);
+        let t = match self {
+            Self::Linear => r,
+            Self::Quadratic => math::sqrt(r),
+        };
+        t * (mips as f32 - 1.0)
+    }
+}
+
+/// Source level for a sample of density `pdf` out of `samples`, on a source cube of face
+/// size `src_size`: `½·log₂(Ωₛ/Ωₚ) + bias`, not clamped. An infinite `pdf` (a mirror-like
+/// lobe) gives `−∞`, a zero `pdf` gives `+∞`; callers clamp to the stored levels.
+#[inline]
+pub fn source_lod(pdf: f32, samples: u32, src_size: u32, bias: f32) -> f32 {
+    let s = src_size as f32;
+    // Ωₛ/Ωₚ = (1/(N·pdf)) / (4π/(6s²)) = 6s² / (4π·N·pdf)
+    let ratio = 6.0 * s * s / (4.0 * math::PI * samples as f32 * pdf);
+    0.5 * math::log2(ratio) + bias
+}
+
+/// Prefiltered radiance in direction `n` (unit) for perceptual `roughness`, from `samples`
+/// GGX samples over the source cube `src`, source levels chosen with `lod_bias`.
+pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, samples: u32, lod_bias: f32) -> Vec4 {
+    let alpha = alpha_from_roughness(math::saturate(roughness));
+    if alpha == 0.0 {
+        return cubemap::sample_bilinear(src, layout, 0, n);
+    }
+    let count = samples.max(1);
+    let mut acc = math::CompensatedSum4::new();
+    let mut wsum = math::CompensatedSum::new();
+    let mut i = 0u32;
+    while i < count {
+        let h = sampling::sample_ggx(sampling::hammersley(i, count), alpha, n);
+        let n_dot_h = n.dot(h);
+        let l = h * (2.0 * n_dot_h) - n;
+        let n_dot_l = n.dot(l);
+        if n_dot_l > 0.0 {
+            let pdf = 0.25 * microfacet::d_ggx(n_dot_h, alpha);
+            let lod = source_lod(pdf, count, layout.size, lod_bias);
+            acc.add(cubemap::sample_lod(src, layout, l, lod) * n_dot_l);
+            wsum.add(n_dot_l);
+        }
+        i += 1;
+    }
+    acc.total() * (1.0 / wsum.total())
+}
+
+/// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`. At
+/// roughness 0 and the source's own resolution it is the source texel, bit for bit.
+pub fn prefilter_texel(
+    src: &[Vec4],
+    layout: CubeLayout,
+    face: u32,
+    x: u32,
+    y: u32,
+    dst_size: u32,
+    roughness: f32,
+    samples: u32,
+    lod_bias: f32,
+) -> Vec4 {
+    if roughness <= 0.0 && dst_size == layout.size {
+        return src[layout.index(0, face, x, y) as usize];
+    }
+    let n = cubemap::texel_dir(face, x, y, dst_size);
+    prefilter_dir(src, layout, n, roughness, samples, lod_bias)
+}
