@@ -1,11 +1,13 @@
 //! The CPU backend: the same `splitsum_shaders` functions the kernels call, run natively
 //! over every texel with rayon, with a progress bar on work that takes a while.
 
-use crate::texture::Lut;
+use crate::texture::{Cube, Equirect, Lut};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
-use splitsum_shaders::lut;
-use splitsum_shaders::glam::Vec2;
+use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
+use splitsum_shaders::glam::{Vec2, Vec4};
+use splitsum_shaders::irradiance::{self, SH9};
+use splitsum_shaders::{equirect, lut, prefilter};
 
 /// A progress bar of `len` steps named `what`; hidden when stderr is not a terminal.
 pub fn progress(what: &str, len: u64) -> ProgressBar {
@@ -31,4 +33,88 @@ pub fn brdf_lut(size: u32, samples: u32) -> Lut {
     });
     bar.finish_and_clear();
     Lut { size, texels }
+}
+
+/// Fills the rows of one cube level, `f(face, x, y)` per texel, in parallel.
+fn fill_level(out: &mut [Vec4], size: u32, bar: &ProgressBar, f: impl Fn(u32, u32, u32) -> Vec4 + Sync) {
+    out.par_chunks_mut(size as usize).enumerate().for_each(|(row, texels)| {
+        let face = row as u32 / size;
+        let y = row as u32 % size;
+        for (x, t) in texels.iter_mut().enumerate() {
+            *t = f(face, x as u32, y);
+        }
+        bar.inc(1);
+    });
+}
+
+/// Level 0 of a cube of face size `size` (with room for its full mip chain) resampled from
+/// `env` with `supersample`² points per texel.
+pub fn equirect_to_cube(env: &Equirect, size: u32, supersample: u32) -> Cube {
+    let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
+    let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
+    let bar = progress("equirect", (FACES * size) as u64);
+    let level0 = &mut texels[..(FACES * size * size) as usize];
+    fill_level(level0, size, &bar, |face, x, y| {
+        equirect::cube_texel(&env.texels, env.width, env.height, face, x, y, size, supersample)
+    });
+    bar.finish_and_clear();
+    Cube { layout, texels }
+}
+
+/// Levels 1.. of `cube` from level 0, by the solid-angle-weighted box filter.
+pub fn build_mips(cube: &mut Cube) {
+    let layout = cube.layout;
+    for level in 0..layout.levels - 1 {
+        let start = layout.level_offset(level + 1) as usize;
+        let (above, below) = cube.texels.split_at_mut(start);
+        let s = layout.level_size(level + 1);
+        let dst = &mut below[..(FACES * s * s) as usize];
+        let src: &[Vec4] = above;
+        dst.par_chunks_mut(s as usize).enumerate().for_each(|(row, texels)| {
+            let face = row as u32 / s;
+            let y = row as u32 % s;
+            for (x, t) in texels.iter_mut().enumerate() {
+                *t = cubemap::downsample_texel(src, layout, level, face, x as u32, y);
+            }
+        });
+    }
+}
+
+/// Every level of the prefiltered specular cube.
+pub fn prefilter(src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Cube {
+    let mut texels = vec![Vec4::ZERO; out.texel_count() as usize];
+    let rows: u64 = (0..out.levels).map(|m| (FACES * out.level_size(m)) as u64).sum();
+    let bar = progress("specular", rows);
+    for m in 0..out.levels {
+        let s = out.level_size(m);
+        let start = out.level_offset(m) as usize;
+        let level = &mut texels[start..start + (FACES * s * s) as usize];
+        let r = roughness[m as usize];
+        fill_level(level, s, &bar, |face, x, y| {
+            prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples, lod_bias)
+        });
+    }
+    bar.finish_and_clear();
+    Cube { layout: out, texels }
+}
+
+/// The irradiance cube (`E/π`) of face size `size`, summed over level `level` of `src`.
+pub fn irradiance(src: &Cube, level: u32, size: u32) -> Cube {
+    let layout = CubeLayout::new(size, 1);
+    let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
+    let bar = progress("irradiance", (FACES * size) as u64);
+    fill_level(&mut texels, size, &bar, |face, x, y| {
+        irradiance::convolve_dir(&src.texels, src.layout, level, cubemap::texel_dir(face, x, y, size))
+    });
+    bar.finish_and_clear();
+    Cube { layout, texels }
+}
+
+/// The per-row SH9 partial sums of level `level` of `src` (see `irradiance::sh9_row`).
+pub fn sh9_rows(src: &Cube, level: u32) -> Vec<[Vec4; SH9 + 1]> {
+    let s = src.layout.level_size(level);
+    (0..FACES * s)
+        .into_par_iter()
+        .map(|row| irradiance::sh9_row(&src.texels, src.layout, level, row / s, row % s))
+        .collect()
 }

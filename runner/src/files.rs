@@ -95,3 +95,38 @@ pub fn lut_preview(lut: &Lut) -> Vec<u8> {
 fn to_u8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }
+
+/// Writes RGB float pixels (alpha dropped) as a 32-bit float OpenEXR with a comment.
+pub fn write_rgb_exr(path: &Path, width: u32, height: u32, pixels: &[splitsum_shaders::glam::Vec4], comment: &str) -> Result<()> {
+    use exr::prelude::*;
+    let w = width as usize;
+    let mut attributes = LayerAttributes::named("rgb");
+    attributes.comments = Some(Text::from(comment));
+    attributes.software_name = Some(Text::from("splitsum"));
+    let layer = Layer::new(
+        (w, height as usize),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        SpecificChannels::rgb(|pos: Vec2<usize>| {
+            let t = pixels[pos.y() * w + pos.x()];
+            (t.x, t.y, t.z)
+        }),
+    );
+    let image = Image::from_layer(layer);
+    let mut buf = std::io::Cursor::new(Vec::new());
+    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file(path, format!("could not encode: {e}")))?;
+    write_atomic(path, |w| w.write_all(buf.get_ref()))
+}
+
+/// Writes level `level` of `cube` as a vertical strip of its six faces (+X, −X, +Y, −Y,
+/// +Z, −Z from the top, each in Vulkan/KTX2 orientation) to an OpenEXR file.
+pub fn write_cube_level_exr(path: &Path, cube: &crate::texture::Cube, level: u32, what: &str) -> Result<()> {
+    let s = cube.layout.level_size(level);
+    write_rgb_exr(
+        path,
+        s,
+        6 * s,
+        cube.level(level),
+        &format!("{what}; mip {level} of a cube map, faces +X -X +Y -Y +Z -Z from the top, Vulkan/KTX2 orientation"),
+    )
+}

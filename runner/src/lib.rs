@@ -5,11 +5,15 @@
 //! bakes. It holds no BRDF or sampling math: that lives once, in `splitsum_shaders`.
 
 pub mod backend;
+pub mod bake;
 pub mod cli;
 pub mod cpu;
+pub mod environment;
 pub mod error;
 pub mod files;
 pub mod gpu;
+pub mod ktx2;
+pub mod preview;
 pub mod texture;
 
 pub use backend::{Backend, BackendKind};

@@ -41,3 +41,39 @@ impl Cube {
         &self.texels[start..start + 6 * s * s]
     }
 }
+
+/// Nine spherical-harmonic coefficients of radiance, RGB (see `splitsum_shaders::irradiance`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sh9 {
+    /// `L_lm` in the order `(0,0), (1,−1), (1,0), (1,1), (2,−2), (2,−1), (2,0), (2,1), (2,2)`.
+    pub radiance: [[f64; 3]; 9],
+}
+
+impl Sh9 {
+    /// Sums per-row partial sums (nine coefficients, then the row's solid angle in `[9].x`)
+    /// in f64 and rescales so that the solid angles add up to exactly 4π.
+    pub fn from_rows(rows: &[[Vec4; 10]]) -> Self {
+        let mut radiance = [[0.0f64; 3]; 9];
+        let mut omega = 0.0f64;
+        for row in rows {
+            for (k, c) in radiance.iter_mut().enumerate() {
+                c[0] += row[k].x as f64;
+                c[1] += row[k].y as f64;
+                c[2] += row[k].z as f64;
+            }
+            omega += row[9].x as f64;
+        }
+        let scale = 4.0 * std::f64::consts::PI / omega;
+        for c in radiance.iter_mut() {
+            for v in c.iter_mut() {
+                *v *= scale;
+            }
+        }
+        Self { radiance }
+    }
+
+    /// The coefficients as the `Vec4` array `splitsum_shaders::irradiance::sh9_irradiance` takes.
+    pub fn as_vec4(&self) -> [Vec4; 9] {
+        self.radiance.map(|c| Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, 0.0))
+    }
+}

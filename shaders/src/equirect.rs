@@ -33,27 +33,49 @@ pub fn uv_to_dir(uv: Vec2) -> Vec3 {
     Vec3::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi)
 }
 
-/// Bilinear lookup in a `width`×`height` RGBA image at `(u, v)`: wraps in `u`, clamps in `v`.
-pub fn sample_bilinear(texels: &[Vec4], width: u32, height: u32, uv: Vec2) -> Vec4 {
-    let fx = uv.x * width as f32 - 0.5;
-    let fy = math::clamp(uv.y * height as f32 - 0.5, 0.0, (height - 1) as f32);
-    let x0f = math::floor(fx);
-    let y0f = math::floor(fy);
-    let tx = fx - x0f;
-    let ty = fy - y0f;
+/// The mean of row `y` over the interval `[a, a + len)` in texel units (wrapping around in
+/// `u`), `1 ≤ len ≤ width`, of the piecewise-constant image: each texel weighs in by its
+/// overlap with the interval.
+fn row_mean(texels: &[Vec4], width: u32, y: u32, a: f32, len: f32) -> Vec4 {
+    let end = a + len;
+    let k0 = math::floor(a) as i32;
+    let k1 = math::floor(end) as i32;
     let w = width as i32;
-    let mut x0 = (x0f as i32) % w;
-    if x0 < 0 {
-        x0 += w;
+    let row = y * width;
+    let mut acc = Vec4::ZERO;
+    let mut k = k0;
+    while k <= k1 {
+        let lo = math::max(k as f32, a);
+        let hi = math::min(k as f32 + 1.0, end);
+        if hi > lo {
+            let mut x = k % w;
+            if x < 0 {
+                x += w;
+            }
+            acc += texels[(row + x as u32) as usize] * (hi - lo);
+        }
+        k += 1;
     }
-    let x1 = if x0 + 1 == w { 0 } else { x0 + 1 };
+    acc * (1.0 / len)
+}
+
+/// Area lookup in a `width`×`height` RGBA image at `(u, v)`: the mean over a window
+/// `window` texels wide in `u` (at least one texel, at most the whole row; wrapping),
+/// interpolated linearly between rows in `v` (clamped). A one-texel window is exactly
+/// bilinear interpolation; wider windows integrate every texel they cover, which is what
+/// keeps narrow features near the poles — where texels shrink in `u` — from being missed.
+pub fn sample_area(texels: &[Vec4], width: u32, height: u32, uv: Vec2, window: f32) -> Vec4 {
+    let w = width as f32;
+    let fy = math::clamp(uv.y * height as f32 - 0.5, 0.0, (height - 1) as f32);
+    let y0f = math::floor(fy);
+    let ty = fy - y0f;
     let y0 = y0f as u32;
     let y1 = if y0 + 1 < height { y0 + 1 } else { y0 };
-    let r0 = y0 * width;
-    let r1 = y1 * width;
-    let a = texels[(r0 + x0 as u32) as usize] * (1.0 - tx) + texels[(r0 + x1 as u32) as usize] * tx;
-    let b = texels[(r1 + x0 as u32) as usize] * (1.0 - tx) + texels[(r1 + x1 as u32) as usize] * tx;
-    a * (1.0 - ty) + b * ty
+    let len = math::clamp(window, 1.0, w);
+    let a = uv.x * w - 0.5 * len;
+    let r0 = row_mean(texels, width, y0, a, len);
+    let r1 = row_mean(texels, width, y1, a, len);
+    r0 * (1.0 - ty) + r1 * ty
 }
 
 /// Points per axis, per cube texel, so that the supersampling grid is `density` times as
@@ -68,10 +90,15 @@ pub fn supersampling(face_size: u32, width: u32, density: f32) -> u32 {
 }
 
 /// Cube texel `(x, y)` of `face` (face size `size`) resampled from the equirect image with
-/// an `n×n` grid of solid-angle-weighted bilinear samples.
+/// an `n×n` grid of solid-angle-weighted samples, each the mean over its own footprint in
+/// `u` ([`sample_area`]): the grid spacing, `2/(size·n)` on the face plane, is about
+/// `2/(size·n·|p|)` radians at point `p`, which near a pole spans `1/sin θ` times more
+/// longitude.
 pub fn cube_texel(texels: &[Vec4], width: u32, height: u32, face: u32, x: u32, y: u32, size: u32, n: u32) -> Vec4 {
     let s = size as f32;
     let nf = n as f32;
+    let spacing = 2.0 / (s * nf);
+    let texels_per_radian = width as f32 * (0.5 * math::FRAC_1_PI);
     let mut acc = Vec4::ZERO;
     let mut wsum = 0.0;
     let mut j = 0;
@@ -84,8 +111,12 @@ pub fn cube_texel(texels: &[Vec4], width: u32, height: u32, face: u32, x: u32, y
             );
             let p = cubemap::face_uv_to_cube(face, uv);
             let r2 = p.dot(p);
-            let w = 1.0 / (r2 * math::sqrt(r2)); // (1 + a² + b²)^(−3/2)
-            acc += sample_bilinear(texels, width, height, dir_to_uv(p)) * w;
+            let r = math::sqrt(r2);
+            let w = 1.0 / (r2 * r); // (1 + a² + b²)^(−3/2)
+            // Longitude spanned by one grid step: (spacing/r) / sin θ, sin θ = √(x²+z²)/r.
+            let rho = math::sqrt(p.x * p.x + p.z * p.z);
+            let window = if rho > 0.0 { spacing / rho * texels_per_radian } else { width as f32 };
+            acc += sample_area(texels, width, height, dir_to_uv(p), window) * w;
             wsum += w;
             i += 1;
         }

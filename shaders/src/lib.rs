@@ -22,5 +22,6 @@ pub mod lut;
 pub mod math;
 pub mod prefilter;
 pub mod sampling;
+pub mod tonemap;
 
 pub use spirv_std::glam;

@@ -39,3 +39,49 @@ pub fn max_diffs(a: impl IntoIterator<Item = f32>, b: impl IntoIterator<Item = f
     }
     (abs, ulp)
 }
+
+/// One of the vendored CC0 environments (`assets/environments/NAME.exr`), as an equirect.
+pub fn environment(name: &str) -> runner::texture::Equirect {
+    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/environments").join(format!("{name}.exr"));
+    match runner::environment::load(&path, false).expect("vendored environment") {
+        (runner::environment::Environment::Equirect(e), _) => e,
+        _ => unreachable!(),
+    }
+}
+
+/// The source cube (with mips) of a vendored environment at face size `size`, on the CPU.
+pub fn source_cube(name: &str, size: u32) -> runner::texture::Cube {
+    let e = environment(name);
+    let n = splitsum_shaders::equirect::supersampling(size, e.width, 2.0);
+    Backend::Cpu.equirect_to_cube(&e, size, n).expect("cpu bake")
+}
+
+/// A cube with full mips whose level 0 is `f(direction)` at the texel centres.
+pub fn cube_from_fn(size: u32, f: impl Fn(splitsum_shaders::glam::Vec3) -> splitsum_shaders::glam::Vec4) -> runner::texture::Cube {
+    use splitsum_shaders::cubemap::{self, CubeLayout};
+    let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
+    let mut texels = vec![splitsum_shaders::glam::Vec4::ZERO; layout.texel_count() as usize];
+    for face in 0..6 {
+        for y in 0..size {
+            for x in 0..size {
+                texels[layout.index(0, face, x, y) as usize] = f(cubemap::texel_dir(face, x, y, size));
+            }
+        }
+    }
+    let mut cube = runner::texture::Cube { layout, texels };
+    Backend::Cpu.build_mips(&mut cube).expect("mips");
+    cube
+}
+
+/// Largest relative difference between two cubes, per channel, relative to
+/// `max(|b|, floor)`.
+pub fn max_relative(a: &[splitsum_shaders::glam::Vec4], b: &[splitsum_shaders::glam::Vec4], floor: f32) -> f32 {
+    assert_eq!(a.len(), b.len());
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| {
+            assert!(x.is_finite() && y.is_finite(), "non-finite texel {x} / {y}");
+            ((*x - *y).abs() / y.abs().max(splitsum_shaders::glam::Vec4::splat(floor))).truncate().max_element()
+        })
+        .fold(0.0, f32::max)
+}

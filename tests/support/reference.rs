@@ -60,3 +60,93 @@ fn brdf_lut_part(n_dot_v: f64, roughness: f64, tol: f64, bias: bool) -> f64 {
     };
     adaptive(&outer, 0.0, PI / 2.0, tol)
 }
+
+/// Unit direction of texel `(x, y)` of `face` (size `s`), in f64, from the face table of
+/// OpenGL 4.6 §8.13 (major axis, s_c, t_c) inverted by hand.
+pub fn texel_dir(face: u32, x: u32, y: u32, s: u32) -> [f64; 3] {
+    let a = 2.0 * (x as f64 + 0.5) / s as f64 - 1.0;
+    let b = 2.0 * (y as f64 + 0.5) / s as f64 - 1.0;
+    let d = match face {
+        0 => [1.0, -b, -a],
+        1 => [-1.0, -b, a],
+        2 => [a, 1.0, b],
+        3 => [a, -1.0, -b],
+        4 => [a, -b, 1.0],
+        _ => [-a, -b, -1.0],
+    };
+    normalize(d)
+}
+
+/// `d / |d|`.
+pub fn normalize(d: [f64; 3]) -> [f64; 3] {
+    let l = dot(d, d).sqrt();
+    [d[0] / l, d[1] / l, d[2] / l]
+}
+
+/// `a·b`.
+pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// Solid angle of texel `(x, y)` of an `s`×`s` face by the corner formula
+/// `Ω = A(x₀,y₀) − A(x₀,y₁) − A(x₁,y₀) + A(x₁,y₁)`, `A(x, y) = atan2(xy, √(x²+y²+1))`
+/// (Driscoll 2012, "Cubemap Texel Solid Angle") — another formula than the code's.
+pub fn texel_solid_angle(x: u32, y: u32, s: u32) -> f64 {
+    let c = |i: u32| 2.0 * i as f64 / s as f64 - 1.0;
+    let a = |u: f64, v: f64| (u * v).atan2((u * u + v * v + 1.0).sqrt());
+    let (x0, x1, y0, y1) = (c(x), c(x + 1), c(y), c(y + 1));
+    a(x0, y0) - a(x0, y1) - a(x1, y0) + a(x1, y1)
+}
+
+/// Every texel of one level (`s`×`s` faces, RGBA) with its direction and solid angle.
+pub fn texels(level: &[splitsum_shaders::glam::Vec4], s: u32) -> Vec<([f64; 3], f64, [f64; 3])> {
+    let mut out = Vec::with_capacity(level.len());
+    for face in 0..6 {
+        for y in 0..s {
+            for x in 0..s {
+                let t = level[((face * s + y) * s + x) as usize];
+                out.push((texel_dir(face, x, y, s), texel_solid_angle(x, y, s), [t.x as f64, t.y as f64, t.z as f64]));
+            }
+        }
+    }
+    out
+}
+
+/// The GGX-prefiltered radiance that the split sum's first term converges to, by an exact
+/// sum over every source texel: with `n = v = r`, `pdf(l) ∝ D(h)` and weight `n·l`,
+/// `L̃(n) = Σ L D(h) max(0, n·l) Ω / Σ D(h) max(0, n·l) Ω`, `h = (n + l)/|n + l|`.
+/// GGX `D` in its textbook form `α² / (π ((n·h)²(α² − 1) + 1)²)`.
+pub fn prefilter(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3], roughness: f64) -> [f64; 3] {
+    let a2 = (roughness * roughness).powi(2);
+    let mut acc = [0.0; 3];
+    let mut wsum = 0.0;
+    for (l, omega, c) in texels {
+        let nl = dot(n, *l);
+        if nl <= 0.0 {
+            continue;
+        }
+        let h = normalize([n[0] + l[0], n[1] + l[1], n[2] + l[2]]);
+        let nh = dot(n, h);
+        let d = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
+        let w = d * nl * omega;
+        for k in 0..3 {
+            acc[k] += w * c[k];
+        }
+        wsum += w;
+    }
+    acc.map(|v| v / wsum)
+}
+
+/// Irradiance over π, `(1/π) Σ L max(0, n·l) Ω`, by an exact sum over every texel.
+pub fn irradiance(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3]) -> [f64; 3] {
+    let mut acc = [0.0; 3];
+    for (l, omega, c) in texels {
+        let nl = dot(n, *l);
+        if nl > 0.0 {
+            for k in 0..3 {
+                acc[k] += c[k] * nl * omega;
+            }
+        }
+    }
+    acc.map(|v| v / PI)
+}

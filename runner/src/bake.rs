@@ -1,0 +1,429 @@
+//! Orchestration of an environment bake: environment → source cube and mips → prefiltered
+//! specular cube, irradiance cube and SH9, plus the BRDF table; then the files. The math
+//! is in `splitsum_shaders`; this module only sequences it, times it and writes results.
+
+use crate::backend::Backend;
+use crate::environment::{Environment, InputReport};
+use crate::error::{Error, Result};
+use crate::files;
+use crate::ktx2::{self, Format};
+use crate::preview;
+use crate::texture::{Cube, Lut, Sh9};
+use serde::Serialize;
+use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::equirect;
+use splitsum_shaders::irradiance::{SH9, SH9_COSINE};
+use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_shaders::tonemap::Tonemapper;
+use std::path::Path;
+use std::time::Instant;
+
+/// How roughness is spread over the specular mips (command-line form of
+/// [`RoughnessMapping`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mapping {
+    /// `r = m/(M−1)`.
+    Linear,
+    /// `r = (m/(M−1))²`.
+    Quadratic,
+}
+
+impl From<Mapping> for RoughnessMapping {
+    fn from(m: Mapping) -> Self {
+        match m {
+            Mapping::Linear => RoughnessMapping::Linear,
+            Mapping::Quadratic => RoughnessMapping::Quadratic,
+        }
+    }
+}
+
+/// Every knob of a bake.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct Settings {
+    /// Face size of the source cube and of mip 0 of the specular cube (a power of two).
+    pub size: u32,
+    /// Mips of the specular cube, one roughness each.
+    pub mips: u32,
+    /// Roughness of each mip.
+    pub mapping: Mapping,
+    /// GGX samples per specular texel.
+    pub samples: u32,
+    /// Added to the source level each prefilter sample reads (`½·log₂(Ωs/Ωp) + bias`).
+    pub lod_bias: f32,
+    /// Supersampling density of the equirect → cube resampling (points per source texel
+    /// width at the equator).
+    pub supersample_density: f32,
+    /// Face size of the irradiance cube.
+    pub irradiance_size: u32,
+    /// Face size of the source level the irradiance convolution sums over.
+    pub irradiance_source: u32,
+    /// Face size of the source level projected onto SH9.
+    pub sh_source: u32,
+    /// Width and height of the BRDF table.
+    pub lut_size: u32,
+    /// Samples per texel of the BRDF table.
+    pub lut_samples: u32,
+    /// Texel format of the KTX2 files.
+    pub format: Format,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            size: 256,
+            mips: 6,
+            mapping: Mapping::Linear,
+            samples: 1024,
+            lod_bias: 1.0,
+            supersample_density: 2.0,
+            irradiance_size: 32,
+            irradiance_source: 32,
+            sh_source: 64,
+            lut_size: 256,
+            lut_samples: 1024,
+            format: Format::Auto,
+        }
+    }
+}
+
+/// Largest cube face accepted.
+pub const MAX_SIZE: u32 = 4096;
+
+impl Settings {
+    /// Checks every value, naming the flag that is out of range.
+    pub fn validate(&self) -> Result<()> {
+        let pow2 = |name: &str, v: u32, lo: u32, hi: u32| -> Result<()> {
+            if !v.is_power_of_two() || v < lo || v > hi {
+                return Err(Error::Invalid(format!("{name} must be a power of two from {lo} to {hi}, not {v}")));
+            }
+            Ok(())
+        };
+        pow2("--size", self.size, 1, MAX_SIZE)?;
+        pow2("--irradiance-size", self.irradiance_size, 1, 256)?;
+        pow2("--irradiance-source", self.irradiance_source, 1, self.size.min(256))?;
+        pow2("--sh-source", self.sh_source, 1, self.size)?;
+        let max_mips = CubeLayout::full_chain(self.size);
+        if self.mips == 0 || self.mips > max_mips {
+            return Err(Error::Invalid(format!("--mips must be from 1 to {max_mips} for --size {}, not {}", self.size, self.mips)));
+        }
+        if self.samples == 0 {
+            return Err(Error::Invalid("--samples must be at least 1".into()));
+        }
+        if !(self.lod_bias.is_finite() && (-16.0..=16.0).contains(&self.lod_bias)) {
+            return Err(Error::Invalid(format!("--lod-bias must be within ±16, not {}", self.lod_bias)));
+        }
+        if !(self.supersample_density > 0.0 && self.supersample_density <= 16.0) {
+            return Err(Error::Invalid(format!("--supersample must be in (0, 16], not {}", self.supersample_density)));
+        }
+        if self.lut_size == 0 || self.lut_size > crate::backend::MAX_LUT_SIZE || self.lut_samples == 0 {
+            return Err(Error::Invalid("--lut-size must be 1..4096 and --lut-samples at least 1".into()));
+        }
+        Ok(())
+    }
+
+    /// Roughness of each specular mip.
+    pub fn roughness(&self) -> Vec<f32> {
+        let m: RoughnessMapping = self.mapping.into();
+        (0..self.mips).map(|i| m.roughness(i, self.mips)).collect()
+    }
+
+    /// Layout of the specular cube.
+    pub fn specular_layout(&self) -> CubeLayout {
+        CubeLayout::new(self.size, self.mips)
+    }
+}
+
+/// The source level whose faces are `face` wide.
+pub fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
+    (0..layout.levels).find(|&l| layout.level_size(l) <= face).unwrap_or(layout.levels - 1)
+}
+
+/// Which products to bake.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Products {
+    /// The prefiltered specular cube.
+    pub specular: bool,
+    /// The irradiance cube.
+    pub irradiance: bool,
+    /// The SH9 coefficients.
+    pub sh9: bool,
+    /// The BRDF table.
+    pub lut: bool,
+}
+
+impl Products {
+    /// Everything.
+    pub const ALL: Products = Products { specular: true, irradiance: true, sh9: true, lut: true };
+}
+
+/// Wall time of one product.
+#[derive(Clone, Debug, Serialize)]
+pub struct Timing {
+    /// The product.
+    pub product: &'static str,
+    /// Seconds.
+    pub seconds: f64,
+}
+
+/// The results of a bake.
+pub struct Baked {
+    /// The source cube with its mips.
+    pub source: Cube,
+    /// The specular cube.
+    pub specular: Option<Cube>,
+    /// The irradiance cube (`E/π`).
+    pub irradiance: Option<Cube>,
+    /// SH9 radiance coefficients.
+    pub sh9: Option<Sh9>,
+    /// The BRDF table.
+    pub lut: Option<Lut>,
+    /// Wall time of each product.
+    pub timings: Vec<Timing>,
+}
+
+fn timed<T>(timings: &mut Vec<Timing>, product: &'static str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    let start = Instant::now();
+    let r = f()?;
+    timings.push(Timing { product, seconds: start.elapsed().as_secs_f64() });
+    Ok(r)
+}
+
+/// The source cube of `env` for `settings`: resampled from an equirect, or the given faces
+/// reduced to `settings.size` through their mip chain.
+pub fn source_cube(backend: &Backend, env: &Environment, settings: &Settings) -> Result<Cube> {
+    match env {
+        Environment::Equirect(e) => {
+            let n = equirect::supersampling(settings.size, e.width, settings.supersample_density);
+            backend.equirect_to_cube(e, settings.size, n)
+        }
+        Environment::Cube(c) => {
+            let f = c.layout.size;
+            if f < settings.size {
+                return Err(Error::Invalid(format!(
+                    "--size {} is larger than the cube's {f}×{f} faces; upsampling adds nothing",
+                    settings.size
+                )));
+            }
+            let mut full = Cube { layout: CubeLayout::new(f, CubeLayout::full_chain(f)), texels: c.texels.clone() };
+            full.texels.resize(full.layout.texel_count() as usize, Default::default());
+            backend.build_mips(&mut full)?;
+            let first = level_of_size(full.layout, settings.size);
+            let layout = CubeLayout::new(settings.size, CubeLayout::full_chain(settings.size));
+            let start = full.layout.level_offset(first) as usize;
+            Ok(Cube { layout, texels: full.texels[start..].to_vec() })
+        }
+    }
+}
+
+/// Bakes `products` of `env` with `settings` on `backend`.
+pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products: Products) -> Result<Baked> {
+    settings.validate()?;
+    let mut timings = Vec::new();
+    let source = timed(&mut timings, "source cube", || source_cube(backend, env, settings))?;
+    let specular = if products.specular {
+        Some(timed(&mut timings, "specular", || {
+            backend.prefilter(&source, settings.specular_layout(), &settings.roughness(), settings.samples, settings.lod_bias)
+        })?)
+    } else {
+        None
+    };
+    let irradiance = if products.irradiance {
+        let level = level_of_size(source.layout, settings.irradiance_source);
+        Some(timed(&mut timings, "irradiance", || backend.irradiance(&source, level, settings.irradiance_size))?)
+    } else {
+        None
+    };
+    let sh9 = if products.sh9 {
+        let level = level_of_size(source.layout, settings.sh_source);
+        Some(timed(&mut timings, "sh9", || backend.sh9(&source, level))?)
+    } else {
+        None
+    };
+    let lut = if products.lut {
+        Some(timed(&mut timings, "brdf lut", || backend.brdf_lut(settings.lut_size, settings.lut_samples))?)
+    } else {
+        None
+    };
+    Ok(Baked { source, specular, irradiance, sh9, lut, timings })
+}
+
+/// One written file.
+#[derive(Clone, Debug, Serialize)]
+pub struct OutputFile {
+    /// Name inside the output folder.
+    pub name: String,
+    /// What it holds.
+    pub what: String,
+    /// How writing it changed values (KTX2 only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub written: Option<ktx2::Written>,
+}
+
+/// `bake.json`: what was baked, how, from what, and how long it took.
+#[derive(Clone, Debug, Serialize)]
+pub struct Manifest {
+    /// The environment file.
+    pub environment: String,
+    /// The backend.
+    pub backend: String,
+    /// Every setting.
+    pub settings: Settings,
+    /// Roughness of each specular mip.
+    pub roughness_per_mip: Vec<f32>,
+    /// What reading the environment found.
+    pub input: InputSummary,
+    /// Wall time per product.
+    pub timings: Vec<Timing>,
+    /// How far SH9 irradiance is from the convolution, over the irradiance cube's texels.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sh9_vs_convolution: Option<ShError>,
+    /// The files.
+    pub files: Vec<OutputFile>,
+    /// Conventions of the outputs.
+    pub conventions: Vec<&'static str>,
+}
+
+/// Relative error of SH9 irradiance against the convolution (luminance), over every texel
+/// of the irradiance cube.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ShError {
+    /// Largest relative error.
+    pub max_relative: f64,
+    /// Root-mean-square relative error.
+    pub rms_relative: f64,
+}
+
+/// Compares SH9 irradiance with the irradiance cube texel by texel.
+pub fn sh9_error(sh: &Sh9, irradiance: &Cube) -> ShError {
+    use splitsum_shaders::{cubemap, irradiance::sh9_irradiance, tonemap::luminance};
+    let coeffs = sh.as_vec4();
+    let s = irradiance.layout.size;
+    let (mut max, mut sum2, mut n) = (0.0f64, 0.0f64, 0usize);
+    for face in 0..6 {
+        for y in 0..s {
+            for x in 0..s {
+                let want = luminance(irradiance.texels[irradiance.layout.index(0, face, x, y) as usize].truncate()) as f64;
+                let got = luminance(sh9_irradiance(&coeffs, cubemap::texel_dir(face, x, y, s))) as f64;
+                if want > 0.0 {
+                    let r = (got - want).abs() / want;
+                    max = max.max(r);
+                    sum2 += r * r;
+                    n += 1;
+                }
+            }
+        }
+    }
+    ShError { max_relative: max, rms_relative: (sum2 / n.max(1) as f64).sqrt() }
+}
+
+/// [`InputReport`] for the manifest.
+#[derive(Clone, Debug, Serialize)]
+pub struct InputSummary {
+    /// Negative values set to 0.
+    pub negative_texels: u64,
+    /// NaN texels (replaced when sanitised).
+    pub nan_texels: u64,
+    /// Infinite texels (replaced when sanitised).
+    pub infinite_texels: u64,
+    /// Largest finite value.
+    pub max_value: f32,
+}
+
+impl From<&InputReport> for InputSummary {
+    fn from(r: &InputReport) -> Self {
+        Self { negative_texels: r.negative, nan_texels: r.nan, infinite_texels: r.infinite, max_value: r.max_value }
+    }
+}
+
+/// The SH9 file: radiance coefficients and the `E/π` coefficients derived from them.
+#[derive(Serialize)]
+struct ShFile<'a> {
+    convention: &'a str,
+    order: [&'a str; 9],
+    radiance: [[f64; 3]; 9],
+    irradiance_over_pi: [[f64; 3]; 9],
+}
+
+/// Writes every baked product into `dir` (created if missing), each file atomically, and
+/// `bake.json` last.
+pub fn write(dir: &Path, baked: &Baked, settings: &Settings, manifest_base: Manifest) -> Result<Manifest> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, format!("cannot create the output folder: {e}")))?;
+    let mut manifest = manifest_base;
+    let mut files_out = Vec::new();
+    let mut add = |name: &str, what: String, written: Option<ktx2::Written>| {
+        files_out.push(OutputFile { name: name.to_string(), what, written });
+    };
+    let exposure = preview::auto_exposure(baked.source.level(0));
+    let save_png = |name: &str, pic: &preview::Picture| -> Result<()> {
+        files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
+    };
+    save_png("preview_source.png", &preview::cross(&baked.source, 0, settings.size.min(256)))?;
+    add("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None);
+    if let Some(spec) = &baked.specular {
+        let w = ktx2::write(&dir.join("specular.ktx2"), spec, settings.format)?;
+        report_clamp("specular.ktx2", &w);
+        add("specular.ktx2", "GGX-prefiltered radiance, one roughness per mip (roughness_per_mip)".into(), Some(w));
+        for m in 0..spec.layout.levels {
+            let name = format!("specular_mip{m}.exr");
+            files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", settings.roughness()[m as usize]))?;
+            add(&name, format!("mip {m} as EXR for inspection"), None);
+        }
+        save_png("preview_specular.png", &preview::mip_strip(spec, 64))?;
+        add("preview_specular.png", "every specular mip as a cross, roughness rising to the right".into(), None);
+    }
+    if let Some(irr) = &baked.irradiance {
+        let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, settings.format)?;
+        report_clamp("irradiance.ktx2", &w);
+        add("irradiance.ktx2", "irradiance divided by π (cosine-weighted mean radiance)".into(), Some(w));
+        files::write_cube_level_exr(&dir.join("irradiance.exr"), irr, 0, "irradiance / pi")?;
+        add("irradiance.exr", "the irradiance cube as EXR for inspection".into(), None);
+        save_png("preview_irradiance.png", &preview::cross(irr, 0, 64))?;
+        add("preview_irradiance.png", "the irradiance cube as a cross".into(), None);
+    }
+    if let Some(sh) = &baked.sh9 {
+        let file = ShFile {
+            convention: "real SH (Sloan 2008), radiance L_lm = sum L Y_lm dOmega; E(n)/pi = sum (A_l/pi) L_lm Y_lm(n), A_l/pi = 1, 2/3, 1/4",
+            order: ["0,0", "1,-1", "1,0", "1,1", "2,-2", "2,-1", "2,0", "2,1", "2,2"],
+            radiance: sh.radiance,
+            irradiance_over_pi: std::array::from_fn(|k| sh.radiance[k].map(|v| v * SH9_COSINE[k] as f64)),
+        };
+        let json = serde_json::to_string_pretty(&file).expect("serialisable");
+        files::write_atomic(&dir.join("sh9.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+        add("sh9.json", format!("{SH9} spherical-harmonic coefficients of radiance and of E/π"), None);
+    }
+    if let Some(lut) = &baked.lut {
+        files::write_lut_exr(&dir.join("brdf_lut.exr"), lut)?;
+        files::write_png(&dir.join("brdf_lut.png"), lut.size, lut.size, &files::lut_preview(lut))?;
+        add("brdf_lut.exr", "split-sum BRDF table: R = scale, G = bias; x = n·v, y = roughness".into(), None);
+        add("brdf_lut.png", "its 8-bit preview".into(), None);
+    }
+    manifest.files = files_out;
+    manifest.timings = baked.timings.clone();
+    if let (Some(sh), Some(irr)) = (&baked.sh9, &baked.irradiance) {
+        manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
+    }
+    let json = serde_json::to_string_pretty(&manifest).expect("serialisable");
+    files::write_atomic(&dir.join("bake.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+    Ok(manifest)
+}
+
+fn report_clamp(name: &str, w: &ktx2::Written) {
+    if w.clamped > 0 {
+        eprintln!(
+            "warning: {name}: {} values above the half-float maximum 65504 (largest {:.4e}) were clamped to 65504; use --format rgba32f to keep them",
+            w.clamped, w.max_value
+        );
+    } else if w.vk_format == ktx2::VK_FORMAT_R32G32B32A32_SFLOAT && w.max_value > ktx2::HALF_MAX {
+        eprintln!("note: {name}: values reach {:.4e}, beyond half floats: written as RGBA32F", w.max_value);
+    }
+}
+
+/// The conventions stated in every manifest.
+pub const CONVENTIONS: [&str; 5] = [
+    "cube faces +X -X +Y -Y +Z -Z, Vulkan/KTX2 orientation (OpenGL 4.6 table 8.19)",
+    "equirect: image centre looks down -Z, +Y up; u = 0.5 + atan2(x, -z)/2pi, v = polar angle/pi",
+    "specular mip m holds roughness roughness_per_mip[m] (alpha = roughness^2), GGX with n = v = r",
+    "irradiance values are E/pi: a Lambert surface of albedo rho reflects rho times the value",
+    "half-float overflow: values above 65504 are clamped and counted (format rgba16f) or kept in rgba32f (format auto)",
+];
