@@ -26,17 +26,31 @@ as_root() {
     fi
 }
 
-ensure_vulkan() {
-    if ls /usr/share/vulkan/icd.d/lvp_icd*.json >/dev/null 2>&1 && ldconfig -p | grep -q 'libvulkan.so.1'; then
-        return
-    fi
+# Installs Debian packages whose marker file is missing: "marker:package" pairs.
+ensure_packages() {
+    local missing=()
+    for pair in "$@"; do
+        local marker=${pair%%:*} package=${pair#*:}
+        if ! compgen -G "$marker" >/dev/null; then missing+=("$package"); fi
+    done
+    [ ${#missing[@]} -eq 0 ] && return
     if command -v apt-get >/dev/null; then
-        echo "dev.sh: installing Mesa's Vulkan drivers (lavapipe runs the GPU backend on the CPU)" >&2
+        echo "dev.sh: installing ${missing[*]}" >&2
         as_root apt-get update -qq >&2 || true
-        as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers libvulkan1 >&2
+        as_root env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}" >&2
     else
-        echo "dev.sh: no Vulkan driver found and no apt-get; install Mesa's lavapipe (mesa-vulkan-drivers) yourself, or use --backend cpu" >&2
+        echo "dev.sh: missing ${missing[*]} and no apt-get to install them" >&2
     fi
+}
+
+# Mesa's lavapipe runs the GPU backend on the CPU where there is no GPU.
+ensure_vulkan() {
+    ensure_packages '/usr/share/vulkan/icd.d/lvp_icd*.json:mesa-vulkan-drivers' '/usr/lib/*/libvulkan.so.1:libvulkan1'
+}
+
+# The windowed smoke test opens the viewer on Xvfb and screenshots it with xwd.
+ensure_test_display() {
+    ensure_packages '/usr/bin/Xvfb:xvfb' '/usr/bin/xwd:x11-apps'
 }
 
 # Quiet libwayland's complaint when wgpu probes for a display on a headless machine.
@@ -55,6 +69,7 @@ case "$cmd" in
         ;;
     test)
         ensure_vulkan
+        ensure_test_display
         exec cargo +"$TOOLCHAIN" test --release --workspace "$@"
         ;;
     cargo)

@@ -41,8 +41,11 @@ impl From<Mapping> for RoughnessMapping {
 /// Every knob of a bake.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct Settings {
-    /// Face size of the source cube and of mip 0 of the specular cube (a power of two).
+    /// Face size of mip 0 of the specular cube (a power of two).
     pub size: u32,
+    /// Face size of the source cube the products are filtered from (a power of two, at
+    /// least `size`).
+    pub source_size: u32,
     /// Mips of the specular cube, one roughness each.
     pub mips: u32,
     /// Roughness of each mip.
@@ -72,6 +75,7 @@ impl Default for Settings {
     fn default() -> Self {
         Self {
             size: 256,
+            source_size: 256,
             mips: 6,
             mapping: Mapping::Linear,
             samples: 1024,
@@ -100,9 +104,10 @@ impl Settings {
             Ok(())
         };
         pow2("--size", self.size, 1, MAX_SIZE)?;
+        pow2("--source-size", self.source_size, self.size, MAX_SIZE)?;
         pow2("--irradiance-size", self.irradiance_size, 1, 256)?;
-        pow2("--irradiance-source", self.irradiance_source, 1, self.size.min(256))?;
-        pow2("--sh-source", self.sh_source, 1, self.size)?;
+        pow2("--irradiance-source", self.irradiance_source, 1, self.source_size.min(256))?;
+        pow2("--sh-source", self.sh_source, 1, self.source_size)?;
         let max_mips = CubeLayout::full_chain(self.size);
         if self.mips == 0 || self.mips > max_mips {
             return Err(Error::Invalid(format!("--mips must be from 1 to {max_mips} for --size {}, not {}", self.size, self.mips)));
@@ -190,26 +195,26 @@ fn timed<T>(timings: &mut Vec<Timing>, product: &'static str, f: impl FnOnce() -
 }
 
 /// The source cube of `env` for `settings`: resampled from an equirect, or the given faces
-/// reduced to `settings.size` through their mip chain.
+/// reduced to `settings.source_size` through their mip chain.
 pub fn source_cube(backend: &Backend, env: &Environment, settings: &Settings) -> Result<Cube> {
+    let size = settings.source_size;
     match env {
         Environment::Equirect(e) => {
-            let n = equirect::supersampling(settings.size, e.width, settings.supersample_density);
-            backend.equirect_to_cube(e, settings.size, n)
+            let n = equirect::supersampling(size, e.width, settings.supersample_density);
+            backend.equirect_to_cube(e, size, n)
         }
         Environment::Cube(c) => {
             let f = c.layout.size;
-            if f < settings.size {
+            if f < size {
                 return Err(Error::Invalid(format!(
-                    "--size {} is larger than the cube's {f}×{f} faces; upsampling adds nothing",
-                    settings.size
+                    "--source-size {size} is larger than the cube's {f}×{f} faces; upsampling adds nothing"
                 )));
             }
             let mut full = Cube { layout: CubeLayout::new(f, CubeLayout::full_chain(f)), texels: c.texels.clone() };
             full.texels.resize(full.layout.texel_count() as usize, Default::default());
             backend.build_mips(&mut full)?;
-            let first = level_of_size(full.layout, settings.size);
-            let layout = CubeLayout::new(settings.size, CubeLayout::full_chain(settings.size));
+            let first = level_of_size(full.layout, size);
+            let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
             let start = full.layout.level_offset(first) as usize;
             Ok(Cube { layout, texels: full.texels[start..].to_vec() })
         }
@@ -358,7 +363,7 @@ pub fn write(dir: &Path, baked: &Baked, settings: &Settings, manifest_base: Mani
     let save_png = |name: &str, pic: &preview::Picture| -> Result<()> {
         files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
     };
-    save_png("preview_source.png", &preview::cross(&baked.source, 0, settings.size.min(256)))?;
+    save_png("preview_source.png", &preview::cross(&baked.source, 0, settings.source_size.min(256)))?;
     add("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None);
     if let Some(spec) = &baked.specular {
         let w = ktx2::write(&dir.join("specular.ktx2"), spec, settings.format)?;
@@ -427,3 +432,16 @@ pub const CONVENTIONS: [&str; 5] = [
     "irradiance values are E/pi: a Lambert surface of albedo rho reflects rho times the value",
     "half-float overflow: values above 65504 are clamped and counted (format rgba16f) or kept in rgba32f (format auto)",
 ];
+
+/// Bakes what the display reads (specular cube, irradiance cube, BRDF table) of `env`.
+pub fn bake_for_display(backend: &Backend, env: &Environment, settings: &Settings) -> Result<crate::render::BakedEnvironment> {
+    let products = Products { specular: true, irradiance: true, sh9: false, lut: true };
+    let baked = bake(backend, env, settings, products)?;
+    Ok(crate::render::BakedEnvironment {
+        source: baked.source,
+        specular: baked.specular.expect("baked"),
+        irradiance: baked.irradiance.expect("baked"),
+        lut: baked.lut.expect("baked"),
+        mapping: settings.mapping.into(),
+    })
+}

@@ -26,14 +26,221 @@ enum Command {
     Bake(BakeArgs),
     /// Time every product of a bake on each backend (a benchmark, not a test).
     Bench(BenchArgs),
+    /// Render the scene offscreen to a PNG (works without a display, on lavapipe or the CPU).
+    Render(RenderArgs),
+    /// Open the interactive viewer (needs a display; `runner render` does without).
+    View(ViewArgs),
+}
+
+#[derive(Args)]
+struct ViewArgs {
+    /// The environment (equirect .hdr/.exr or a six-face folder) [default: the embedded courtyard].
+    env: Option<PathBuf>,
+    /// Window width.
+    #[arg(long, default_value_t = 960)]
+    width: u32,
+    /// Window height.
+    #[arg(long, default_value_t = 540)]
+    height: u32,
+    /// Close the window after this many seconds.
+    #[arg(long)]
+    exit_after: Option<f64>,
+    #[command(flatten)]
+    look: LookArgs,
+    #[command(flatten)]
+    bake: DisplayBakeArgs,
+}
+
+/// What to look at and how.
+#[derive(Args, Clone)]
+pub struct LookArgs {
+    /// Diffuse model.
+    #[arg(long, value_enum, default_value_t = DiffuseArg::Lambert)]
+    pub diffuse: DiffuseArg,
+    /// Specular model.
+    #[arg(long, value_enum, default_value_t = SpecularArg::CookTorrance)]
+    pub specular: SpecularArg,
+    /// Fresnel form.
+    #[arg(long, value_enum, default_value_t = FresnelArg::Schlick)]
+    pub fresnel: FresnelArg,
+    /// Turn image-based lighting off.
+    #[arg(long)]
+    pub no_ibl: bool,
+    /// Turn the direct lights off.
+    #[arg(long)]
+    pub no_lights: bool,
+    /// Exposure in stops, added to the automatic exposure of the environment.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Tone curve.
+    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
+    pub tonemapper: TonemapArg,
+    /// Blur of the sky behind the scene, in specular mips (0 = sharp).
+    #[arg(long, default_value_t = 0.0)]
+    pub sky_blur: f32,
+    /// Camera orbit angle, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub yaw: f32,
+    /// Camera elevation, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub pitch: f32,
+}
+
+/// Diffuse models.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum DiffuseArg {
+    /// ρ/π.
+    Lambert,
+    /// Oren–Nayar, σ = roughness.
+    OrenNayar,
+    /// Ashikhmin–Shirley's Fresnel-weighted diffuse.
+    FresnelWeighted,
+}
+
+/// Specular models.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SpecularArg {
+    /// GGX, Smith–Schlick, Fresnel.
+    CookTorrance,
+    /// Normalised Phong.
+    Phong,
+    /// Normalised Blinn–Phong.
+    BlinnPhong,
+    /// No specular.
+    None,
+}
+
+/// Fresnel forms.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FresnelArg {
+    /// Schlick.
+    Schlick,
+    /// UE4's spherical Gaussian.
+    SphericalGaussian,
+}
+
+/// Tone curves.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TonemapArg {
+    /// Narkowicz's ACES fit.
+    Aces,
+    /// Reinhard.
+    Reinhard,
+    /// Clamp.
+    Clamp,
+}
+
+impl LookArgs {
+    /// The view these flags describe, with `auto_exposure` from the environment.
+    pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
+        use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
+        use splitsum_shaders::tonemap::Tonemapper;
+        let mut flags = 0;
+        if !self.no_ibl {
+            flags |= ShadeOptions::IBL;
+        }
+        if !self.no_lights {
+            flags |= ShadeOptions::DIRECT;
+        }
+        crate::render::ViewState {
+            yaw: self.yaw.to_radians(),
+            pitch: self.pitch.to_radians(),
+            exposure: auto_exposure * 2f32.powf(self.exposure),
+            tonemapper: match self.tonemapper {
+                TonemapArg::Aces => Tonemapper::Aces,
+                TonemapArg::Reinhard => Tonemapper::Reinhard,
+                TonemapArg::Clamp => Tonemapper::Clamp,
+            },
+            sky_blur: self.sky_blur,
+            options: ShadeOptions {
+                diffuse: match self.diffuse {
+                    DiffuseArg::Lambert => diffuse_model::LAMBERT,
+                    DiffuseArg::OrenNayar => diffuse_model::OREN_NAYAR,
+                    DiffuseArg::FresnelWeighted => diffuse_model::FRESNEL_WEIGHTED,
+                },
+                specular: match self.specular {
+                    SpecularArg::CookTorrance => specular_model::COOK_TORRANCE,
+                    SpecularArg::Phong => specular_model::PHONG,
+                    SpecularArg::BlinnPhong => specular_model::BLINN_PHONG,
+                    SpecularArg::None => specular_model::NONE,
+                },
+                fresnel: match self.fresnel {
+                    FresnelArg::Schlick => fresnel_model::SCHLICK,
+                    FresnelArg::SphericalGaussian => fresnel_model::SPHERICAL_GAUSSIAN,
+                },
+                flags,
+            },
+            ..Default::default()
+        }
+    }
+}
+
+/// The display's bake: quicker defaults than `bake`, for an interactive start.
+#[derive(Args, Clone)]
+pub struct DisplayBakeArgs {
+    /// Face size of the specular cube.
+    #[arg(long, default_value_t = 128)]
+    pub size: u32,
+    /// GGX samples per specular texel.
+    #[arg(long, default_value_t = 256)]
+    pub samples: u32,
+    /// Replace NaN/inf texels instead of refusing the environment.
+    #[arg(long)]
+    pub sanitize: bool,
+}
+
+impl DisplayBakeArgs {
+    /// Bake settings for the display of `env`: the source cube as sharp as the environment
+    /// (a quarter of an equirect's width, up to 1024), the rest from the flags.
+    pub fn settings(&self, env: &environment::Environment) -> Settings {
+        let mips = CubeLayout::full_chain(self.size.max(1)).saturating_sub(3).max(1);
+        let native = match env {
+            environment::Environment::Equirect(e) => (e.width / 4).max(1).next_power_of_two().min(1024),
+            environment::Environment::Cube(c) => c.layout.size.min(1024),
+        };
+        Settings {
+            size: self.size,
+            source_size: native.max(self.size),
+            mips,
+            samples: self.samples,
+            lut_size: 128,
+            lut_samples: 512,
+            ..Settings::default()
+        }
+    }
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// The environment (equirect .hdr/.exr or a six-face folder) [default: the embedded courtyard].
+    env: Option<PathBuf>,
+    /// Output PNG.
+    #[arg(long, default_value = "frame.png")]
+    out: PathBuf,
+    /// Width in pixels.
+    #[arg(long, default_value_t = 960)]
+    width: u32,
+    /// Height in pixels.
+    #[arg(long, default_value_t = 540)]
+    height: u32,
+    /// Bake and render on the GPU, or bake and render on the CPU (the reference renderer).
+    #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
+    backend: BackendKind,
+    #[command(flatten)]
+    look: LookArgs,
+    #[command(flatten)]
+    bake: DisplayBakeArgs,
 }
 
 /// The quality knobs of a bake.
 #[derive(Args, Clone)]
 pub struct QualityArgs {
-    /// Face size of the source cube and of mip 0 of the specular cube (a power of two).
+    /// Face size of mip 0 of the specular cube (a power of two).
     #[arg(long, default_value_t = 256)]
     pub size: u32,
+    /// Face size of the source cube the products are filtered from [default: --size].
+    #[arg(long)]
+    pub source_size: Option<u32>,
     /// Specular mips, one roughness each [default: down to 8×8 faces].
     #[arg(long)]
     pub mips: Option<u32>,
@@ -75,6 +282,7 @@ impl QualityArgs {
         let mips = self.mips.unwrap_or_else(|| CubeLayout::full_chain(self.size.max(1)).saturating_sub(3).max(1));
         Settings {
             size: self.size,
+            source_size: self.source_size.unwrap_or(self.size),
             mips,
             mapping: self.mapping,
             samples: self.samples,
@@ -153,13 +361,9 @@ where
         Some(Command::Lut(args)) => lut(args),
         Some(Command::Bake(args)) => bake_command(args),
         Some(Command::Bench(args)) => bench(args),
-        None => lut(LutArgs {
-            size: 256,
-            samples: 1024,
-            backend: BackendKind::Gpu,
-            out: PathBuf::from("lut.exr"),
-            png: true,
-        }),
+        Some(Command::Render(args)) => render(args),
+        Some(Command::View(args)) => view(args),
+        None => default_run(),
     }
 }
 
@@ -273,5 +477,125 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         }
         println!("  {:<12} {:>9.3} s", "total", best.iter().map(|t| t.seconds).sum::<f64>());
     }
+    Ok(())
+}
+
+/// The environment at `path`, or the embedded default.
+pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyhow::Result<(environment::Environment, String)> {
+    match path {
+        Some(p) => {
+            let (env, input) = environment::load(p, sanitize)?;
+            if input.negative > 0 {
+                eprintln!("note: {}: {} texels had negative values, set to 0", p.display(), input.negative);
+            }
+            Ok((env, p.display().to_string()))
+        }
+        None => Ok((environment::embedded_default()?, "the embedded courtyard (CC0)".to_string())),
+    }
+}
+
+fn render(args: RenderArgs) -> anyhow::Result<()> {
+    crate::render::check_size(args.width, args.height)?;
+    files::check_writable(&args.out)?;
+    let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
+    let backend = Backend::open(args.backend)?;
+    let start = Instant::now();
+    let baked = bake::bake_for_display(&backend, &env, &args.bake.settings(&env))?;
+    let bake_secs = start.elapsed().as_secs_f64();
+    let view = args.look.view(baked.auto_exposure());
+    let start = Instant::now();
+    let pixels = match &backend {
+        Backend::Gpu(g) => {
+            let scene = crate::render::GpuScene::new(g, &baked);
+            scene.render_offscreen(g, &view.frame(scene.shape, args.width, args.height, true))?
+        }
+        Backend::Cpu => crate::render::render_cpu(&baked, &view.frame(baked.shape(), args.width, args.height, true)),
+    };
+    let render_secs = start.elapsed().as_secs_f64();
+    files::write_png(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels))?;
+    println!("{name} on {}: bake {bake_secs:.2} s, render {render_secs:.3} s", backend.describe());
+    println!("{}", view.summary());
+    println!("wrote {}", args.out.display());
+    Ok(())
+}
+
+fn view(args: ViewArgs) -> anyhow::Result<()> {
+    if !crate::view::display_available() {
+        anyhow::bail!("no display (neither DISPLAY nor WAYLAND_DISPLAY is set); `runner render --out frame.png` renders without one");
+    }
+    crate::render::check_size(args.width, args.height)?;
+    let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
+    let backend = Backend::open(BackendKind::Gpu)?;
+    let start = Instant::now();
+    let baked = bake::bake_for_display(&backend, &env, &args.bake.settings(&env))?;
+    println!("{name} baked on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
+    let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
+    let state = args.look.view(baked.auto_exposure());
+    let options = crate::view::ViewOptions {
+        exit_after: args.exit_after.map(std::time::Duration::from_secs_f64),
+        exit_after_frames: None,
+        on_presented: None,
+        size: (args.width, args.height),
+    };
+    crate::view::run(*gpu, &baked, state, options)?;
+    Ok(())
+}
+
+/// `runner` with no arguments: bake the embedded environment and show the sphere grid in a
+/// window, or, where there is no display (or no GPU), render it to `splitsum.png`.
+fn default_run() -> anyhow::Result<()> {
+    let (env, name) = load_environment(None, false)?;
+    let backend = match Backend::open(BackendKind::Gpu) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("{e}\nfalling back to the CPU backend");
+            Backend::Cpu
+        }
+    };
+    let display = DisplayBakeArgs { size: 128, samples: 256, sanitize: false };
+    let start = Instant::now();
+    let baked = bake::bake_for_display(&backend, &env, &display.settings(&env))?;
+    println!("baked {name} on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
+    let look = LookArgs {
+        diffuse: DiffuseArg::Lambert,
+        specular: SpecularArg::CookTorrance,
+        fresnel: FresnelArg::Schlick,
+        no_ibl: false,
+        no_lights: false,
+        exposure: 0.0,
+        tonemapper: TonemapArg::Aces,
+        sky_blur: 0.0,
+        yaw: 0.0,
+        pitch: 0.0,
+    };
+    let state = look.view(baked.auto_exposure());
+    let backend = match backend {
+        Backend::Gpu(gpu) if crate::view::display_available() => {
+            let options = crate::view::ViewOptions { size: (960, 540), ..Default::default() };
+            let gpu = *gpu;
+            match crate::view::run(gpu, &baked, state.clone(), options) {
+                Ok(()) => return Ok(()),
+                Err(e) => {
+                    eprintln!("{e}; rendering to a file instead");
+                    Backend::open(BackendKind::Gpu).unwrap_or(Backend::Cpu)
+                }
+            }
+        }
+        b => b,
+    };
+    let (w, h) = (960, 540);
+    let out = PathBuf::from("splitsum.png");
+    files::check_writable(&out)?;
+    let pixels = match &backend {
+        Backend::Gpu(g) => {
+            let scene = crate::render::GpuScene::new(g, &baked);
+            scene.render_offscreen(g, &state.frame(scene.shape, w, h, true))?
+        }
+        Backend::Cpu => crate::render::render_cpu(&baked, &state.frame(baked.shape(), w, h, true)),
+    };
+    files::write_png(&out, w, h, &crate::render::to_rgb8(&pixels))?;
+    let shown = std::fs::canonicalize(&out).unwrap_or(out);
+    println!("no display here: rendered the sphere grid ({w}×{h}) to {}", shown.display());
+    println!("{}", state.summary());
     Ok(())
 }

@@ -242,3 +242,15 @@ pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputRe
     report.max_value = channel_max.iter().copied().fold(0.0, f32::max);
     Ok(report)
 }
+
+/// The environment `runner` shows when given none: Greg Zaal's "courtyard" (CC0, see
+/// `assets/environments/LICENSE.md`), embedded in the binary.
+pub static EMBEDDED_DEFAULT: &[u8] = include_bytes!("../../assets/environments/courtyard.exr");
+
+/// Decodes [`EMBEDDED_DEFAULT`].
+pub fn embedded_default() -> Result<Environment> {
+    let path = Path::new("<embedded courtyard.exr>");
+    let (width, height, mut texels) = read_exr(path, EMBEDDED_DEFAULT)?;
+    clean(path, &mut texels, false)?;
+    Ok(Environment::Equirect(Equirect { width, height, texels }))
+}

@@ -56,6 +56,12 @@ impl Kernel {
 
 /// A wgpu device with every kernel's pipeline ready.
 pub struct Gpu {
+    /// The instance (kept for creating window surfaces).
+    pub instance: wgpu::Instance,
+    /// The adapter.
+    pub adapter: wgpu::Adapter,
+    /// The SPIR-V module of `splitsum-shaders` (compute, vertex and fragment entry points).
+    pub module: wgpu::ShaderModule,
     /// The device.
     pub device: wgpu::Device,
     /// Its queue.
@@ -81,13 +87,17 @@ pub struct Dispatch<'a> {
     pub groups: [u32; 3],
 }
 
-/// The adapters wgpu can see through Vulkan, best first: discrete, integrated, virtual,
-/// then CPU (lavapipe); only those whose name contains `filter`, if given.
-pub fn vulkan_adapters(filter: Option<&str>) -> Vec<wgpu::Adapter> {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+/// A Vulkan-only wgpu instance.
+pub fn vulkan_instance() -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor {
         backends: wgpu::Backends::VULKAN,
         ..wgpu::InstanceDescriptor::new_without_display_handle()
-    });
+    })
+}
+
+/// The adapters `instance` can see through Vulkan, best first: discrete, integrated,
+/// virtual, then CPU (lavapipe); only those whose name contains `filter`, if given.
+pub fn vulkan_adapters(instance: &wgpu::Instance, filter: Option<&str>) -> Vec<wgpu::Adapter> {
     let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
     let rank = |t: wgpu::DeviceType| match t {
         wgpu::DeviceType::DiscreteGpu => 0,
@@ -113,17 +123,18 @@ impl Gpu {
 
     /// Opens the best Vulkan adapter whose name contains `filter` (any, if `None`).
     pub fn matching(filter: Option<&str>) -> Result<Self> {
-        let adapter = vulkan_adapters(filter).into_iter().next().ok_or_else(|| Error::NoAdapter {
+        let instance = vulkan_instance();
+        let adapter = vulkan_adapters(&instance, filter).into_iter().next().ok_or_else(|| Error::NoAdapter {
             detail: match filter {
                 Some(want) => format!(" whose name contains {want:?} (SPLITSUM_ADAPTER)"),
                 None => String::new(),
             },
         })?;
-        Self::with_adapter(adapter)
+        Self::with_adapter(instance, adapter)
     }
 
-    /// Builds the device and pipelines on `adapter`.
-    pub fn with_adapter(adapter: wgpu::Adapter) -> Result<Self> {
+    /// Builds the device and pipelines on `adapter` of `instance`.
+    pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
         let info = adapter.get_info();
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("splitsum"),
@@ -193,7 +204,7 @@ impl Gpu {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        Ok(Self { device, queue, info, layout, pipelines, empty })
+        Ok(Self { instance, adapter, module, device, queue, info, layout, pipelines, empty })
     }
 
     /// A one-line description of the adapter.

@@ -14,7 +14,9 @@ pub mod files;
 pub mod gpu;
 pub mod ktx2;
 pub mod preview;
+pub mod render;
 pub mod texture;
+pub mod view;
 
 pub use backend::{Backend, BackendKind};
 pub use error::{Error, Result};

@@ -15,6 +15,7 @@
 
 pub mod brdf;
 pub mod cubemap;
+pub mod display;
 pub mod equirect;
 pub mod irradiance;
 pub mod kernels;
@@ -22,6 +23,8 @@ pub mod lut;
 pub mod math;
 pub mod prefilter;
 pub mod sampling;
+pub mod scene;
+pub mod shade;
 pub mod tonemap;
 
 pub use spirv_std::glam;

@@ -102,7 +102,8 @@ pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, 
 }
 
 /// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`. At
-/// roughness 0 and the source's own resolution it is the source texel, bit for bit.
+/// roughness 0 it is the texel of the source level of the same size, bit for bit (or a
+/// bilinear lookup of level 0 if the source has no level that size).
 pub fn prefilter_texel(
     src: &[Vec4],
     layout: CubeLayout,
@@ -114,8 +115,14 @@ pub fn prefilter_texel(
     samples: u32,
     lod_bias: f32,
 ) -> Vec4 {
-    if roughness <= 0.0 && dst_size == layout.size {
-        return src[layout.index(0, face, x, y) as usize];
+    if roughness <= 0.0 {
+        let mut level = 0;
+        while level < layout.levels {
+            if layout.level_size(level) == dst_size {
+                return src[layout.index(level, face, x, y) as usize];
+            }
+            level += 1;
+        }
     }
     let n = cubemap::texel_dir(face, x, y, dst_size);
     prefilter_dir(src, layout, n, roughness, samples, lod_bias)

@@ -66,14 +66,20 @@ pub fn key_exposure(log_average: f32) -> f32 {
     if log_average > 0.0 { 0.18 / log_average } else { 1.0 }
 }
 
-/// Linear radiance to display sRGB in [0, 1]: exposure, tone curve, encoding.
+/// Linear radiance to linear display values in [0, 1]: exposure and tone curve.
 #[inline]
-pub fn display(c: Vec3, exposure: f32, curve: Tonemapper) -> Vec3 {
+pub fn tone(c: Vec3, exposure: f32, curve: Tonemapper) -> Vec3 {
     let e = c * exposure;
-    let t = match curve {
+    match curve {
         Tonemapper::Aces => Vec3::new(aces(e.x), aces(e.y), aces(e.z)),
         Tonemapper::Reinhard => Vec3::new(reinhard(e.x), reinhard(e.y), reinhard(e.z)),
         Tonemapper::Clamp => Vec3::new(math::saturate(e.x), math::saturate(e.y), math::saturate(e.z)),
-    };
+    }
+}
+
+/// Linear radiance to display sRGB in [0, 1]: exposure, tone curve, encoding.
+#[inline]
+pub fn display(c: Vec3, exposure: f32, curve: Tonemapper) -> Vec3 {
+    let t = tone(c, exposure, curve);
     Vec3::new(linear_to_srgb(t.x), linear_to_srgb(t.y), linear_to_srgb(t.z))
 }

@@ -1,0 +1,372 @@
+//! Drawing the scene: the view state a user changes (camera, models, exposure…), the frame
+//! block it becomes, the GPU renderer (the `display` shaders on a window or an offscreen
+//! texture) and the CPU reference renderer (the same `scene::pixel`, per pixel, with rayon).
+
+use crate::error::{Error, Result};
+use crate::gpu::Gpu;
+use crate::texture::{Cube, Lut};
+use rayon::prelude::*;
+use splitsum_shaders::glam::{UVec4, Vec2, Vec3, Vec4};
+use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_shaders::scene::{self, Frame, Light, MAX_LIGHTS};
+use splitsum_shaders::shade::{EnvironmentShape, ShadeOptions, diffuse_model, fresnel_model, specular_model};
+use splitsum_shaders::tonemap::Tonemapper;
+
+/// The baked products the display reads.
+#[derive(Clone)]
+pub struct BakedEnvironment {
+    /// The source cube (the sharp sky).
+    pub source: Cube,
+    /// Prefiltered specular cube.
+    pub specular: Cube,
+    /// Irradiance cube (`E/π`).
+    pub irradiance: Cube,
+    /// BRDF table.
+    pub lut: Lut,
+    /// Roughness of the specular mips.
+    pub mapping: RoughnessMapping,
+}
+
+impl BakedEnvironment {
+    /// An exposure at which a white Lambert surface shows, on average, at 0.5 before the
+    /// tone curve: `0.5 / mean(E/π)` over the irradiance cube.
+    pub fn auto_exposure(&self) -> f32 {
+        let t = &self.irradiance.texels;
+        let mean = t.iter().map(|c| splitsum_shaders::tonemap::luminance(c.truncate()) as f64).sum::<f64>() / t.len().max(1) as f64;
+        if mean > 0.0 { (0.5 / mean) as f32 } else { 1.0 }
+    }
+
+    /// The shapes the shaders need.
+    pub fn shape(&self) -> EnvironmentShape {
+        EnvironmentShape {
+            specular_size: self.specular.layout.size,
+            specular_levels: self.specular.layout.levels,
+            mapping: self.mapping as u32,
+            irradiance_size: self.irradiance.layout.size,
+            lut_size: self.lut.size,
+            source_size: self.source.layout.size,
+            source_levels: 1,
+            pad: 0,
+        }
+    }
+}
+
+/// Everything a user can change while looking.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewState {
+    /// Orbit angle about the vertical axis, radians.
+    pub yaw: f32,
+    /// Orbit elevation, radians.
+    pub pitch: f32,
+    /// Distance from the target.
+    pub distance: f32,
+    /// The point orbited.
+    pub target: Vec3,
+    /// Vertical field of view, radians.
+    pub fov: f32,
+    /// Exposure multiplier.
+    pub exposure: f32,
+    /// Tone curve.
+    pub tonemapper: Tonemapper,
+    /// Sky blur, in specular mips.
+    pub sky_blur: f32,
+    /// Models and lights.
+    pub options: ShadeOptions,
+    /// Sphere grid rows (metalness) and columns (roughness).
+    pub grid: (u32, u32),
+    /// Draw the sphere grid.
+    pub spheres: bool,
+    /// Base colour of the spheres.
+    pub base_color: Vec3,
+    /// Direct lights.
+    pub lights: Vec<Light>,
+}
+
+impl Default for ViewState {
+    fn default() -> Self {
+        Self {
+            yaw: 0.0,
+            pitch: 0.0,
+            distance: 8.0,
+            target: Vec3::ZERO,
+            fov: 45f32.to_radians(),
+            exposure: 1.0,
+            tonemapper: Tonemapper::Aces,
+            sky_blur: 0.0,
+            options: ShadeOptions::DEFAULT,
+            grid: (5, 7),
+            spheres: true,
+            base_color: Vec3::new(0.9, 0.45, 0.2),
+            lights: vec![
+                Light { position: Vec4::new(-0.5, 0.8, 0.6, 0.0).normalize() * Vec4::new(1.0, 1.0, 1.0, 0.0), radiance: Vec4::new(3.0, 2.9, 2.7, 0.0) },
+                Light { position: Vec4::new(3.0, 2.0, 4.0, 1.0), radiance: Vec4::new(20.0, 20.0, 24.0, 0.0) },
+            ],
+        }
+    }
+}
+
+/// Names of the models, for titles and reports.
+pub fn diffuse_name(code: u32) -> &'static str {
+    match code {
+        diffuse_model::OREN_NAYAR => "Oren-Nayar",
+        diffuse_model::FRESNEL_WEIGHTED => "Fresnel-weighted",
+        _ => "Lambert",
+    }
+}
+
+/// Name of a specular model.
+pub fn specular_name(code: u32) -> &'static str {
+    match code {
+        specular_model::PHONG => "Phong",
+        specular_model::BLINN_PHONG => "Blinn-Phong",
+        specular_model::NONE => "none",
+        _ => "Cook-Torrance",
+    }
+}
+
+/// Name of a Fresnel form.
+pub fn fresnel_name(code: u32) -> &'static str {
+    if code == fresnel_model::SPHERICAL_GAUSSIAN { "spherical Gaussian" } else { "Schlick" }
+}
+
+/// Name of a tone curve.
+pub fn tonemapper_name(t: Tonemapper) -> &'static str {
+    match t {
+        Tonemapper::Aces => "ACES",
+        Tonemapper::Reinhard => "Reinhard",
+        Tonemapper::Clamp => "clamp",
+    }
+}
+
+impl ViewState {
+    /// Camera position.
+    pub fn eye(&self) -> Vec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        self.target + Vec3::new(cp * sy, sp, cp * cy) * self.distance
+    }
+
+    /// A one-line summary of the choices (the window title).
+    pub fn summary(&self) -> String {
+        let o = self.options;
+        format!(
+            "diffuse {} | specular {} | Fresnel {} | IBL {} | lights {} | exposure {:.2} | {} | sky blur {:.1}",
+            diffuse_name(o.diffuse),
+            specular_name(o.specular),
+            fresnel_name(o.fresnel),
+            if o.flags & ShadeOptions::IBL != 0 { "on" } else { "off" },
+            if o.flags & ShadeOptions::DIRECT != 0 { "on" } else { "off" },
+            self.exposure,
+            tonemapper_name(self.tonemapper),
+            self.sky_blur
+        )
+    }
+
+    /// The frame block for a `width`×`height` target. `encode_srgb`: the target stores what
+    /// it is given (a UNORM format), so the shader encodes sRGB itself.
+    pub fn frame(&self, shape: EnvironmentShape, width: u32, height: u32, encode_srgb: bool) -> Frame {
+        let eye = self.eye();
+        let forward = (self.target - eye).normalize();
+        let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
+        let up = right.cross(forward);
+        let mut lights = [Light { position: Vec4::ZERO, radiance: Vec4::ZERO }; MAX_LIGHTS];
+        for (slot, l) in lights.iter_mut().zip(&self.lights) {
+            *slot = *l;
+        }
+        let mut flags = 0;
+        if encode_srgb {
+            flags |= Frame::ENCODE_SRGB;
+        }
+        if self.spheres {
+            flags |= Frame::SPHERES;
+        }
+        Frame {
+            eye: eye.extend(1.0),
+            forward: forward.extend((0.5 * self.fov).tan()),
+            right: right.extend(width as f32 / height as f32),
+            up: up.extend(0.0),
+            viewport: Vec4::new(width as f32, height as f32, self.exposure, self.sky_blur),
+            grid: UVec4::new(self.grid.0, self.grid.1, self.tonemapper as u32, self.lights.len().min(MAX_LIGHTS) as u32),
+            flags: UVec4::new(flags, 0, 0, 0),
+            options: self.options,
+            shape,
+            base_color: self.base_color.extend(1.0),
+            lights,
+        }
+    }
+}
+
+/// The CPU reference renderer: `scene::pixel` at every pixel centre, row 0 at the top.
+pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
+    let (w, h) = (frame.viewport.x as u32, frame.viewport.y as u32);
+    let mut out = vec![Vec4::ZERO; (w * h) as usize];
+    out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        for (x, p) in row.iter_mut().enumerate() {
+            let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            *p = scene::pixel(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, px);
+        }
+    });
+    out
+}
+
+/// The scene pipeline and the baked buffers on the GPU.
+pub struct GpuScene {
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: std::sync::Mutex<Vec<(wgpu::TextureFormat, wgpu::RenderPipeline)>>,
+    frame_buffer: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    /// The shapes of the baked buffers.
+    pub shape: EnvironmentShape,
+}
+
+impl GpuScene {
+    /// Uploads `env` and prepares the bindings.
+    pub fn new(gpu: &Gpu, env: &BakedEnvironment) -> Self {
+        let device = &gpu.device;
+        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let ro = wgpu::BufferBindingType::Storage { read_only: true };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("scene bindings"),
+            entries: &[entry(0, wgpu::BufferBindingType::Uniform), entry(1, ro), entry(2, ro), entry(3, ro), entry(4, ro)],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene layout"),
+            bind_group_layouts: &[None, Some(&layout)],
+            immediate_size: 0,
+        });
+        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame"),
+            size: std::mem::size_of::<Frame>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let specular = gpu.upload("specular", bytemuck::cast_slice(&env.specular.texels));
+        let irradiance = gpu.upload("irradiance", bytemuck::cast_slice(&env.irradiance.texels));
+        let lut = gpu.upload("brdf lut", bytemuck::cast_slice(&env.lut.texels));
+        let source = gpu.upload("source", bytemuck::cast_slice(&env.source.level(0)));
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: frame_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: specular.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: irradiance.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: lut.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: source.as_entire_binding() },
+            ],
+        });
+        Self { pipeline_layout, pipelines: Default::default(), frame_buffer, bind_group, shape: env.shape() }
+    }
+
+    fn pipeline(&self, gpu: &Gpu, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+        let mut cache = self.pipelines.lock().expect("pipeline cache");
+        if let Some((_, p)) = cache.iter().find(|(f, _)| *f == format) {
+            return p.clone();
+        }
+        let p = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("scene"),
+            layout: Some(&self.pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &gpu.module,
+                entry_point: Some("display::fullscreen_vs"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: None,
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &gpu.module,
+                entry_point: Some("display::scene_fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        cache.push((format, p.clone()));
+        p
+    }
+
+    /// Records drawing `frame` into `view` (of `format`).
+    pub fn draw(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, view: &wgpu::TextureView, format: wgpu::TextureFormat, frame: &Frame) {
+        gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(frame));
+        let pipeline = self.pipeline(gpu, format);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("scene"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(1, &self.bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+
+    /// Renders `frame` offscreen into an RGBA32F texture and reads it back (row 0 at the top).
+    pub fn render_offscreen(&self, gpu: &Gpu, frame: &Frame) -> Result<Vec<Vec4>> {
+        let (w, h) = (frame.viewport.x as u32, frame.viewport.y as u32);
+        let format = wgpu::TextureFormat::Rgba32Float;
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("offscreen"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.draw(gpu, &mut encoder, &view, format, frame);
+        let row = (w as u64 * 16).div_ceil(256) * 256;
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("offscreen readback"),
+            size: row * h as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row as u32), rows_per_image: Some(h) },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        gpu.queue.submit([encoder.finish()]);
+        let bytes = gpu.read(&buffer)?;
+        let mut out = Vec::with_capacity((w * h) as usize);
+        for y in 0..h as usize {
+            let start = y * row as usize;
+            out.extend(bytemuck::pod_collect_to_vec::<u8, Vec4>(&bytes[start..start + w as usize * 16]));
+        }
+        Ok(out)
+    }
+}
+
+/// Display values in [0, 1] to 8-bit RGB.
+pub fn to_rgb8(pixels: &[Vec4]) -> Vec<u8> {
+    pixels.iter().flat_map(|p| [p.x, p.y, p.z].map(|v| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)).collect()
+}
+
+/// Checks an output size.
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 || width > 8192 || height > 8192 {
+        return Err(Error::Invalid(format!("--width and --height must be 1..8192, not {width}×{height}")));
+    }
+    Ok(())
+}

@@ -1,0 +1,220 @@
+//! The viewer's scene, evaluated per pixel the same way by the fragment shader and by the
+//! CPU reference renderer: a pinhole camera, an analytic grid of spheres (rows of rising
+//! metalness, columns of rising roughness) ray-cast exactly, direct lights, and the sky
+//! drawn from the specular cube at a chosen blur.
+//!
+//! Ray–sphere intersection with the half-`b` form `t = −b − √(b² − c)`,
+//! `b = (o−c)·d`, `c = |o−c|² − R²` (Pharr, Jakob & Humphreys, *PBRT* 4e §6.2.2).
+
+use crate::cubemap::{self, CubeLayout};
+use crate::shade::{self, EnvironmentShape, Material, ShadeOptions};
+use crate::{math, sampling, tonemap};
+use bytemuck::{Pod, Zeroable};
+use spirv_std::glam::{UVec4, Vec2, Vec3, Vec4};
+
+/// Most direct lights in a frame.
+pub const MAX_LIGHTS: usize = 4;
+
+/// A direct light.
+#[derive(Copy, Clone, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct Light {
+    /// `w = 0`: unit direction towards a distant light; `w = 1`: position of a point light.
+    pub position: Vec4,
+    /// RGB radiance arriving from a distant light, or a point light's intensity (the
+    /// radiance it delivers at distance 1; it falls off as 1/d²).
+    pub radiance: Vec4,
+}
+
+/// Everything a frame needs besides the baked buffers (a uniform block: every field is a
+/// 16-byte vector so the layout is the same in Rust and in std140).
+#[derive(Copy, Clone, Debug, PartialEq, Pod, Zeroable)]
+#[repr(C)]
+pub struct Frame {
+    /// Camera position (xyz).
+    pub eye: Vec4,
+    /// Unit view direction (xyz); `w` = tan(vertical field of view / 2).
+    pub forward: Vec4,
+    /// Unit right vector (xyz); `w` = width / height.
+    pub right: Vec4,
+    /// Unit up vector (xyz).
+    pub up: Vec4,
+    /// Width and height in pixels, exposure, sky blur (a specular mip, fractional).
+    pub viewport: Vec4,
+    /// Grid rows (metalness), grid columns (roughness), tonemapper code, light count.
+    pub grid: UVec4,
+    /// Bit 0: encode sRGB in the shader; bit 1: draw the sphere grid; bit 2: output linear
+    /// radiance (no exposure, tone curve or encoding; for tests).
+    pub flags: UVec4,
+    /// Shading models and lights.
+    pub options: ShadeOptions,
+    /// Shapes of the baked buffers.
+    pub shape: EnvironmentShape,
+    /// Base colour of the spheres (linear RGB).
+    pub base_color: Vec4,
+    /// Direct lights; the first `grid.w` are used.
+    pub lights: [Light; MAX_LIGHTS],
+}
+
+impl Frame {
+    /// Encode sRGB in the shader (the target is a UNORM format).
+    pub const ENCODE_SRGB: u32 = 1;
+    /// Draw the sphere grid.
+    pub const SPHERES: u32 = 2;
+    /// Output linear radiance.
+    pub const LINEAR: u32 = 4;
+}
+
+/// Spacing of the sphere grid's centres.
+pub const GRID_SPACING: f32 = 1.0;
+/// Radius of the grid's spheres.
+pub const SPHERE_RADIUS: f32 = 0.42;
+
+/// The unit ray through pixel position `px` (pixel centres at half-integers, y down).
+#[inline]
+pub fn camera_ray(frame: &Frame, px: Vec2) -> Vec3 {
+    let tan = frame.forward.w;
+    let aspect = frame.right.w;
+    let x = (2.0 * px.x / frame.viewport.x - 1.0) * tan * aspect;
+    let y = (1.0 - 2.0 * px.y / frame.viewport.y) * tan;
+    let d = frame.forward.truncate() + frame.right.truncate() * x + frame.up.truncate() * y;
+    sampling::normalize_or(d, frame.forward.truncate())
+}
+
+/// Centre of the sphere in `row`, `col` of a `rows`×`cols` grid centred on the origin in the
+/// plane `z = 0` (row 0 at the top).
+#[inline]
+pub fn sphere_centre(row: u32, col: u32, rows: u32, cols: u32) -> Vec3 {
+    Vec3::new(
+        (col as f32 - 0.5 * (cols as f32 - 1.0)) * GRID_SPACING,
+        (0.5 * (rows as f32 - 1.0) - row as f32) * GRID_SPACING,
+        0.0,
+    )
+}
+
+/// The nearest sphere hit along the ray: `(t, row, col)`, `t < 0` if none.
+pub fn hit_grid(frame: &Frame, origin: Vec3, dir: Vec3) -> (f32, u32, u32) {
+    let rows = frame.grid.x;
+    let cols = frame.grid.y;
+    let mut best = -1.0f32;
+    let mut best_row = 0;
+    let mut best_col = 0;
+    let mut row = 0;
+    while row < rows {
+        let mut col = 0;
+        while col < cols {
+            let oc = origin - sphere_centre(row, col, rows, cols);
+            let b = oc.dot(dir);
+            let c = oc.dot(oc) - SPHERE_RADIUS * SPHERE_RADIUS;
+            let disc = b * b - c;
+            if disc >= 0.0 {
+                let t = -b - math::sqrt(disc);
+                if t > 0.0 && (best < 0.0 || t < best) {
+                    best = t;
+                    best_row = row;
+                    best_col = col;
+                }
+            }
+            col += 1;
+        }
+        row += 1;
+    }
+    (best, best_row, best_col)
+}
+
+/// The material of the sphere in `row`, `col`: metalness rises down the rows, roughness
+/// along the columns, each from 0 to 1.
+#[inline]
+pub fn grid_material(frame: &Frame, row: u32, col: u32) -> Material {
+    Material {
+        base_color: frame.base_color.truncate(),
+        metallic: step(row, frame.grid.x),
+        roughness: step(col, frame.grid.y),
+        occlusion: 1.0,
+        emissive: Vec3::ZERO,
+    }
+}
+
+/// `i/(n−1)`, or 0 for a single step.
+#[inline]
+fn step(i: u32, n: u32) -> f32 {
+    if n > 1 { i as f32 / (n - 1) as f32 } else { 0.0 }
+}
+
+/// Radiance leaving point `p` (normal `n`) towards the eye along `v`: emission, the
+/// image-based light and every direct light.
+pub fn shade_point(frame: &Frame, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], m: &Material, p: Vec3, n: Vec3, v: Vec3) -> Vec3 {
+    let mut color = m.emissive;
+    let opts = frame.options;
+    if opts.flags & ShadeOptions::IBL != 0 {
+        let s = shade::ibl_sample(frame.shape, specular, irradiance, table, n, v, m.roughness);
+        color += shade::ibl(opts, m, n, v, s);
+    }
+    if opts.flags & ShadeOptions::DIRECT != 0 {
+        let count = if (frame.grid.w as usize) < MAX_LIGHTS { frame.grid.w as usize } else { MAX_LIGHTS };
+        let mut i = 0;
+        while i < count {
+            let light = frame.lights[i];
+            let (l, radiance) = if light.position.w == 0.0 {
+                (sampling::normalize_or(light.position.truncate(), n), light.radiance.truncate())
+            } else {
+                let to = light.position.truncate() - p;
+                let d2 = math::max(to.dot(to), 1e-8);
+                (to * (1.0 / math::sqrt(d2)), light.radiance.truncate() * (1.0 / d2))
+            };
+            color += shade::direct(opts, m, n, v, l, radiance);
+            i += 1;
+        }
+    }
+    color
+}
+
+/// Linear radiance seen through pixel position `px`: a sphere of the grid, or the sky.
+pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> Vec3 {
+    let origin = frame.eye.truncate();
+    let dir = camera_ray(frame, px);
+    if frame.flags.x & Frame::SPHERES != 0 {
+        let (t, row, col) = hit_grid(frame, origin, dir);
+        if t > 0.0 {
+            let p = origin + dir * t;
+            let n = sampling::normalize_or(p - sphere_centre(row, col, frame.grid.x, frame.grid.y), -dir);
+            let m = grid_material(frame, row, col);
+            return shade_point(frame, specular, irradiance, table, &m, p, n, -dir);
+        }
+    }
+    sky(frame, source, specular, dir)
+}
+
+/// The sky along `dir`: the source cube when the blur is 0, else the specular cube at the
+/// blur level (a fractional mip, i.e. a roughness).
+#[inline]
+pub fn sky(frame: &Frame, source: &[Vec4], specular: &[Vec4], dir: Vec3) -> Vec3 {
+    let blur = frame.viewport.w;
+    if blur > 0.0 {
+        let layout = CubeLayout::new(frame.shape.specular_size, frame.shape.specular_levels);
+        cubemap::sample_lod(specular, layout, dir, blur).truncate()
+    } else {
+        let layout = CubeLayout::new(frame.shape.source_size, frame.shape.source_levels);
+        cubemap::sample_bilinear(source, layout, 0, dir).truncate()
+    }
+}
+
+/// Display value of linear radiance `c` for this frame: exposure, tone curve, and the
+/// sRGB encoding when the target does not encode itself.
+#[inline]
+pub fn to_display(frame: &Frame, c: Vec3) -> Vec4 {
+    if frame.flags.x & Frame::LINEAR != 0 {
+        return c.extend(1.0);
+    }
+    let curve = tonemap::Tonemapper::from_u32(frame.grid.z);
+    if frame.flags.x & Frame::ENCODE_SRGB != 0 {
+        tonemap::display(c, frame.viewport.z, curve).extend(1.0)
+    } else {
+        tonemap::tone(c, frame.viewport.z, curve).extend(1.0)
+    }
+}
+
+/// The value of pixel position `px`.
+pub fn pixel(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> Vec4 {
+    to_display(frame, radiance(frame, source, specular, irradiance, table, px))
+}

@@ -1,0 +1,274 @@
+//! Shading a surface point: direct lights plus image-based lighting, with a choice of
+//! diffuse, specular and Fresnel models (each defined in [`crate::brdf`]).
+//!
+//! **Direct light** (Karis 2013, "Specular BRDF"; LearnOpenGL "Lighting"): for each light of
+//! radiance `E` arriving from `l`,
+//! `L_o = (k_d f_d + f_s) E (n·l)` with, for Cook–Torrance, `f_s = D·Vis·F`, GGX `D`
+//! (α = r²), Smith–Schlick visibility with `k = (r+1)²/8`, Fresnel at `v·h`, and the
+//! diffuse weight `k_d = (1 − F)(1 − metallic)` (Lambert, Oren–Nayar). The Fresnel-weighted
+//! diffuse carries its own Fresnel factor and is weighted by `1 − metallic` only.
+//!
+//! **Image-based light** (Karis 2013 eq. 8, the split sum; LearnOpenGL "Specular IBL"):
+//! `F = F₀ + (max(1 − r, F₀) − F₀)(1 − n·v)⁵` (or its spherical-Gaussian twin),
+//! `k_d = (1 − F)(1 − metallic)`,
+//! `L_o = (k_d ρ E/π + L̃(r)·(F·A + B))·ao`,
+//! with `E/π` the irradiance cube, `L̃` the prefiltered cube at the mip holding roughness
+//! `r` (trilinear), `(A, B)` the BRDF table at `(n·v, r)`. Phong and Blinn–Phong use the
+//! prefiltered cube times `F` (the GGX table does not apply to them). Oren–Nayar under the
+//! irradiance is treated as Lambert (a cosine-convolved irradiance has no view dependence to
+//! give it); the Fresnel-weighted diffuse multiplies in its view factor
+//! `1 − (1 − n·v/2)⁵` and the cosine-weighted mean of its light factor,
+//! `2∫₀¹ (1 − (1 − μ/2)⁵) μ dμ = 23/28`, which cancels its `28/23` normalisation.
+//!
+//! Materials follow glTF 2.0's metallic–roughness model: `F₀ = mix(0.04, base, metallic)`,
+//! diffuse albedo `ρ = base·(1 − metallic)`.
+
+use crate::brdf::{alpha_from_roughness, diffuse, fresnel, microfacet, phong};
+use crate::cubemap::{self, CubeLayout};
+use crate::prefilter::RoughnessMapping;
+use crate::{lut, math, sampling};
+use bytemuck::{Pod, Zeroable};
+use spirv_std::glam::{Vec2, Vec3, Vec4};
+
+/// Smallest roughness used with analytic lights. A point light reflected by a perfect
+/// mirror is a delta: zero in every direction but one that no pixel hits. At r = 0.02
+/// (α = 4·10⁻⁴) the highlight peak `D = 1/(πα²)` is 2·10⁶, still finite in f32 after
+/// multiplication by a 10⁶ sun (Filament uses 0.045 for the same reason in half floats).
+pub const MIN_DIRECT_ROUGHNESS: f32 = 0.02;
+
+/// Smallest `n·v` shaded (see `lut::MIN_N_DOT_V`): normals facing away from the viewer,
+/// which interpolated and normal-mapped normals produce, are shaded as grazing.
+pub const MIN_N_DOT_V: f32 = lut::MIN_N_DOT_V;
+
+/// Diffuse model.
+pub mod diffuse_model {
+    /// Lambert.
+    pub const LAMBERT: u32 = 0;
+    /// Oren–Nayar with σ = roughness.
+    pub const OREN_NAYAR: u32 = 1;
+    /// Ashikhmin–Shirley's Fresnel-weighted diffuse.
+    pub const FRESNEL_WEIGHTED: u32 = 2;
+    /// Number of models.
+    pub const COUNT: u32 = 3;
+}
+
+/// Specular model.
+pub mod specular_model {
+    /// Cook–Torrance with GGX and Smith–Schlick.
+    pub const COOK_TORRANCE: u32 = 0;
+    /// Normalised Phong.
+    pub const PHONG: u32 = 1;
+    /// Normalised Blinn–Phong.
+    pub const BLINN_PHONG: u32 = 2;
+    /// No specular term.
+    pub const NONE: u32 = 3;
+    /// Number of models.
+    pub const COUNT: u32 = 4;
+}
+
+/// Fresnel form.
+pub mod fresnel_model {
+    /// Schlick's `(1 − cos θ)⁵`.
+    pub const SCHLICK: u32 = 0;
+    /// UE4's spherical Gaussian.
+    pub const SPHERICAL_GAUSSIAN: u32 = 1;
+    /// Number of forms.
+    pub const COUNT: u32 = 2;
+}
+
+/// Which models and which light to use.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Pod, Zeroable)]
+#[repr(C)]
+pub struct ShadeOptions {
+    /// A [`diffuse_model`] constant.
+    pub diffuse: u32,
+    /// A [`specular_model`] constant.
+    pub specular: u32,
+    /// A [`fresnel_model`] constant.
+    pub fresnel: u32,
+    /// Bit 0: image-based light on; bit 1: direct lights on.
+    pub flags: u32,
+}
+
+impl ShadeOptions {
+    /// Image-based light on.
+    pub const IBL: u32 = 1;
+    /// Direct lights on.
+    pub const DIRECT: u32 = 2;
+
+    /// Cook–Torrance, Lambert, Schlick, both lights.
+    pub const DEFAULT: ShadeOptions = ShadeOptions {
+        diffuse: diffuse_model::LAMBERT,
+        specular: specular_model::COOK_TORRANCE,
+        fresnel: fresnel_model::SCHLICK,
+        flags: Self::IBL | Self::DIRECT,
+    };
+}
+
+/// A glTF metallic–roughness material at one point.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Base colour (linear).
+    pub base_color: Vec3,
+    /// Metalness in [0, 1].
+    pub metallic: f32,
+    /// Perceptual roughness in [0, 1].
+    pub roughness: f32,
+    /// Ambient occlusion in [0, 1] (image-based light only).
+    pub occlusion: f32,
+    /// Emitted radiance.
+    pub emissive: Vec3,
+}
+
+impl Material {
+    /// Normal-incidence reflectance `mix(0.04, base, metallic)`.
+    #[inline]
+    pub fn f0(&self) -> Vec3 {
+        Vec3::splat(0.04).lerp(self.base_color, self.metallic)
+    }
+
+    /// Diffuse albedo `base·(1 − metallic)`.
+    #[inline]
+    pub fn albedo(&self) -> Vec3 {
+        self.base_color * (1.0 - self.metallic)
+    }
+}
+
+/// Fresnel at `cos_theta` in the chosen form.
+#[inline]
+pub fn fresnel(form: u32, f0: Vec3, cos_theta: f32) -> Vec3 {
+    if form == fresnel_model::SPHERICAL_GAUSSIAN {
+        fresnel::spherical_gaussian3(f0, cos_theta)
+    } else {
+        fresnel::schlick3(f0, cos_theta)
+    }
+}
+
+/// The roughness-aware Fresnel of the ambient term in the chosen form.
+#[inline]
+pub fn fresnel_ambient(form: u32, f0: Vec3, n_dot_v: f32, roughness: f32) -> Vec3 {
+    if form == fresnel_model::SPHERICAL_GAUSSIAN {
+        let g = Vec3::splat(1.0 - roughness).max(f0);
+        f0 + (g - f0) * fresnel::spherical_gaussian_weight(n_dot_v)
+    } else {
+        fresnel::schlick_roughness3(f0, n_dot_v, roughness)
+    }
+}
+
+/// Outgoing radiance towards `v` from one light of radiance `radiance` arriving from `l`
+/// (all unit vectors, `n` the shading normal).
+pub fn direct(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, l: Vec3, radiance: Vec3) -> Vec3 {
+    let n_dot_l = n.dot(l);
+    if !(n_dot_l > 0.0) {
+        return Vec3::ZERO;
+    }
+    let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
+    let h = sampling::normalize_or(l + v, n);
+    let v_dot_h = math::saturate(v.dot(h));
+    let f0 = m.f0();
+    let f = fresnel(opts.fresnel, f0, v_dot_h);
+    let r = math::max(m.roughness, MIN_DIRECT_ROUGHNESS);
+    let alpha = alpha_from_roughness(r);
+    let specular = if opts.specular == specular_model::COOK_TORRANCE {
+        let d = microfacet::d_ggx_vec(n, h, alpha);
+        let vis = microfacet::vis_smith_schlick(n_dot_v, n_dot_l, microfacet::k_direct(r));
+        f * (d * vis)
+    } else if opts.specular == specular_model::PHONG {
+        let refl = sampling::reflect(v, n);
+        f * phong::phong(refl.dot(l), 0.25 * phong::blinn_exponent(alpha))
+    } else if opts.specular == specular_model::BLINN_PHONG {
+        f * phong::blinn_phong(n.dot(h), phong::blinn_exponent(alpha))
+    } else {
+        Vec3::ZERO
+    };
+    let no_metal = 1.0 - m.metallic;
+    let diffuse = if opts.diffuse == diffuse_model::FRESNEL_WEIGHTED {
+        diffuse::fresnel_weighted(m.base_color, f0, n_dot_l, n_dot_v) * no_metal
+    } else {
+        let kd = (Vec3::ONE - f) * no_metal;
+        if opts.diffuse == diffuse_model::OREN_NAYAR {
+            kd * diffuse::oren_nayar(m.base_color, m.roughness, n_dot_l, n_dot_v, l.dot(v))
+        } else {
+            kd * diffuse::lambert(m.base_color)
+        }
+    };
+    (diffuse + specular) * radiance * n_dot_l
+}
+
+/// What the image-based light reads for one shading point: the prefiltered radiance
+/// `L̃(r)` along the reflection, the irradiance `E/π` along the normal, the BRDF table.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct IblSample {
+    /// Prefiltered specular radiance.
+    pub prefiltered: Vec3,
+    /// Irradiance divided by π.
+    pub irradiance: Vec3,
+    /// `(A, B)` from the BRDF table.
+    pub brdf: Vec2,
+}
+
+/// The baked environment as the shading reads it: buffers and their shapes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Pod, Zeroable)]
+#[repr(C)]
+pub struct EnvironmentShape {
+    /// Face size of mip 0 of the specular cube.
+    pub specular_size: u32,
+    /// Mips of the specular cube.
+    pub specular_levels: u32,
+    /// `RoughnessMapping` code of the specular mips.
+    pub mapping: u32,
+    /// Face size of the irradiance cube.
+    pub irradiance_size: u32,
+    /// Width of the BRDF table.
+    pub lut_size: u32,
+    /// Face size of the source cube (the sharp sky).
+    pub source_size: u32,
+    /// Mips of the source cube.
+    pub source_levels: u32,
+    /// Unused; keeps the block a multiple of 16 bytes.
+    pub pad: u32,
+}
+
+/// Reads the three baked products for normal `n`, view `v` and `roughness`.
+pub fn ibl_sample(
+    shape: EnvironmentShape,
+    specular: &[Vec4],
+    irradiance: &[Vec4],
+    table: &[Vec2],
+    n: Vec3,
+    v: Vec3,
+    roughness: f32,
+) -> IblSample {
+    let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
+    let r = sampling::reflect(v, n);
+    let spec_layout = CubeLayout::new(shape.specular_size, shape.specular_levels);
+    let lod = RoughnessMapping::from_u32(shape.mapping).lod(roughness, shape.specular_levels);
+    IblSample {
+        prefiltered: cubemap::sample_lod(specular, spec_layout, r, lod).truncate(),
+        irradiance: cubemap::sample_bilinear(irradiance, CubeLayout::new(shape.irradiance_size, 1), 0, n).truncate(),
+        brdf: lut::sample(table, shape.lut_size, n_dot_v, roughness),
+    }
+}
+
+/// Outgoing radiance towards `v` from the image-based light.
+pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> Vec3 {
+    let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
+    let f0 = m.f0();
+    let f = fresnel_ambient(opts.fresnel, f0, n_dot_v, m.roughness);
+    let no_metal = 1.0 - m.metallic;
+    let diffuse = if opts.diffuse == diffuse_model::FRESNEL_WEIGHTED {
+        let view = 1.0 - math::pow5(1.0 - 0.5 * n_dot_v);
+        // (28/23)·(23/28): the light factor's cosine-weighted mean cancels the normalisation.
+        m.base_color * (Vec3::ONE - f0) * (no_metal * view) * s.irradiance
+    } else {
+        (Vec3::ONE - f) * no_metal * m.base_color * s.irradiance
+    };
+    let specular = if opts.specular == specular_model::COOK_TORRANCE {
+        s.prefiltered * (f * s.brdf.x + Vec3::splat(s.brdf.y))
+    } else if opts.specular == specular_model::NONE {
+        Vec3::ZERO
+    } else {
+        s.prefiltered * f
+    };
+    (diffuse + specular) * m.occlusion
+}
