@@ -60,7 +60,7 @@ fn gpu_matches_the_cpu_reference() {
                     ..ViewState::default()
                 };
                 let frame = view.frame(scene.shape, 96, 64, true);
-                let g = scene.render_offscreen(gpu, &frame).unwrap();
+                let g = scene.render_offscreen(gpu, &frame, None).unwrap();
                 let c = render_cpu(&env, &frame);
                 let (worst, over) = diff(&g, &c);
                 worst_all = worst_all.max(worst);

@@ -87,14 +87,14 @@ fn the_viewer_window_shows_the_scene() {
         size: (w, h),
     };
     let gpu = runner::gpu::Gpu::new().expect("a Vulkan adapter (lavapipe)");
-    runner::view::run(gpu, &baked, state.clone(), options).expect("the viewer ran");
+    runner::view::run(gpu, &baked, None, state.clone(), options).expect("the viewer ran");
     let (sw, _sh, pixels) = shot.lock().unwrap().take().expect("a screenshot was taken");
 
     // The window (at the origin: Xvfb has no window manager) against the same frame
     // rendered offscreen.
     let gpu = runner::gpu::Gpu::new().unwrap();
     let scene = GpuScene::new(&gpu, &baked);
-    let want = scene.render_offscreen(&gpu, &state.frame(scene.shape, w, h, true)).unwrap();
+    let want = scene.render_offscreen(&gpu, &state.frame(scene.shape, w, h, true), None).unwrap();
     let mut sum = 0.0f64;
     let mut lit = 0usize;
     for y in 0..h {

@@ -84,6 +84,16 @@ pub struct LookArgs {
     /// Camera elevation, degrees.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub pitch: f32,
+    /// A glTF 2.0 model (.gltf or .glb) to show beside the spheres [default: the bundled
+    /// textured torus].
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Show no model.
+    #[arg(long, conflicts_with = "model")]
+    pub no_model: bool,
+    /// Hide the sphere grid.
+    #[arg(long)]
+    pub no_grid: bool,
 }
 
 /// Diffuse models.
@@ -142,7 +152,9 @@ impl LookArgs {
         if !self.no_lights {
             flags |= ShadeOptions::DIRECT;
         }
-        crate::render::ViewState {
+        let mut view = crate::render::ViewState {
+            spheres: !self.no_grid,
+            show_model: !self.no_model,
             yaw: self.yaw.to_radians(),
             pitch: self.pitch.to_radians(),
             exposure: auto_exposure * 2f32.powf(self.exposure),
@@ -171,7 +183,23 @@ impl LookArgs {
                 flags,
             },
             ..Default::default()
+        };
+        view.frame_contents();
+        view
+    }
+
+    /// The model to show, placed beside the grid (or centred without it), if any.
+    pub fn load_model(&self) -> anyhow::Result<Option<crate::model::Model>> {
+        if self.no_model {
+            return Ok(None);
         }
+        let mut m = match &self.model {
+            Some(p) => crate::model::load(p)?,
+            None => crate::model::embedded_sample()?,
+        };
+        let (centre, size) = crate::model::PLACE_BESIDE_GRID;
+        m.fit(centre, size);
+        Ok(Some(m))
     }
 }
 
@@ -503,13 +531,17 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let baked = bake::bake_for_display(&backend, &env, &args.bake.settings(&env))?;
     let bake_secs = start.elapsed().as_secs_f64();
     let view = args.look.view(baked.auto_exposure());
+    let model = args.look.load_model()?;
     let start = Instant::now();
-    let pixels = match &backend {
-        Backend::Gpu(g) => {
+    let frame = view.frame(baked.shape(), args.width, args.height, true);
+    let pixels = match (&backend, &model) {
+        (Backend::Gpu(g), m) => {
             let scene = crate::render::GpuScene::new(g, &baked);
-            scene.render_offscreen(g, &view.frame(scene.shape, args.width, args.height, true))?
+            let gm = m.as_ref().map(|m| crate::render::GpuModel::new(g, &scene, m));
+            scene.render_offscreen(g, &frame, gm.as_ref())?
         }
-        Backend::Cpu => crate::render::render_cpu(&baked, &view.frame(baked.shape(), args.width, args.height, true)),
+        (Backend::Cpu, Some(m)) => crate::raster::render(&baked, &frame, m),
+        (Backend::Cpu, None) => crate::render::render_cpu(&baked, &frame),
     };
     let render_secs = start.elapsed().as_secs_f64();
     files::write_png(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels))?;
@@ -531,13 +563,14 @@ fn view(args: ViewArgs) -> anyhow::Result<()> {
     println!("{name} baked on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
     let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
     let state = args.look.view(baked.auto_exposure());
+    let model = args.look.load_model()?;
     let options = crate::view::ViewOptions {
         exit_after: args.exit_after.map(std::time::Duration::from_secs_f64),
         exit_after_frames: None,
         on_presented: None,
         size: (args.width, args.height),
     };
-    crate::view::run(*gpu, &baked, state, options)?;
+    crate::view::run(*gpu, &baked, model.as_ref(), state, options)?;
     Ok(())
 }
 
@@ -567,13 +600,16 @@ fn default_run() -> anyhow::Result<()> {
         sky_blur: 0.0,
         yaw: 0.0,
         pitch: 0.0,
+        model: None,
+        no_model: true,
+        no_grid: false,
     };
     let state = look.view(baked.auto_exposure());
     let backend = match backend {
         Backend::Gpu(gpu) if crate::view::display_available() => {
             let options = crate::view::ViewOptions { size: (960, 540), ..Default::default() };
             let gpu = *gpu;
-            match crate::view::run(gpu, &baked, state.clone(), options) {
+            match crate::view::run(gpu, &baked, None, state.clone(), options) {
                 Ok(()) => return Ok(()),
                 Err(e) => {
                     eprintln!("{e}; rendering to a file instead");
@@ -589,7 +625,7 @@ fn default_run() -> anyhow::Result<()> {
     let pixels = match &backend {
         Backend::Gpu(g) => {
             let scene = crate::render::GpuScene::new(g, &baked);
-            scene.render_offscreen(g, &state.frame(scene.shape, w, h, true))?
+            scene.render_offscreen(g, &state.frame(scene.shape, w, h, true), None)?
         }
         Backend::Cpu => crate::render::render_cpu(&baked, &state.frame(baked.shape(), w, h, true)),
     };

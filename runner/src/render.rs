@@ -4,9 +4,11 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
+use crate::model::{Model, SLOTS, Texture, Vertex};
+use wgpu::util::DeviceExt;
 use crate::texture::{Cube, Lut};
 use rayon::prelude::*;
-use splitsum_shaders::glam::{UVec4, Vec2, Vec3, Vec4};
+use splitsum_shaders::glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::scene::{self, Frame, Light, MAX_LIGHTS};
 use splitsum_shaders::shade::{EnvironmentShape, ShadeOptions, diffuse_model, fresnel_model, specular_model};
@@ -76,6 +78,8 @@ pub struct ViewState {
     pub grid: (u32, u32),
     /// Draw the sphere grid.
     pub spheres: bool,
+    /// Draw the model (when there is one).
+    pub show_model: bool,
     /// Base colour of the spheres.
     pub base_color: Vec3,
     /// Direct lights.
@@ -96,6 +100,7 @@ impl Default for ViewState {
             options: ShadeOptions::DEFAULT,
             grid: (5, 7),
             spheres: true,
+            show_model: false,
             base_color: Vec3::new(0.9, 0.45, 0.2),
             lights: vec![
                 Light { position: Vec4::new(-0.5, 0.8, 0.6, 0.0).normalize() * Vec4::new(1.0, 1.0, 1.0, 0.0), radiance: Vec4::new(3.0, 2.9, 2.7, 0.0) },
@@ -139,6 +144,16 @@ pub fn tonemapper_name(t: Tonemapper) -> &'static str {
 }
 
 impl ViewState {
+    /// Points the camera at what is shown: the grid, the model beside it, or both.
+    pub fn frame_contents(&mut self) {
+        let (centre, size) = crate::model::PLACE_BESIDE_GRID;
+        (self.target, self.distance) = match (self.spheres, self.show_model) {
+            (true, true) => (Vec3::new(0.5 * (centre.x - 3.4), 0.0, 0.0), 11.0),
+            (false, true) => (centre, 2.2 * size),
+            _ => (Vec3::ZERO, 8.0),
+        };
+    }
+
     /// Camera position.
     pub fn eye(&self) -> Vec3 {
         let (sy, cy) = self.yaw.sin_cos();
@@ -150,7 +165,7 @@ impl ViewState {
     pub fn summary(&self) -> String {
         let o = self.options;
         format!(
-            "diffuse {} | specular {} | Fresnel {} | IBL {} | lights {} | exposure {:.2} | {} | sky blur {:.1}",
+            "diffuse {} | specular {} | Fresnel {} | IBL {} | lights {} | exposure {:.2} | {} | sky blur {:.1}{}",
             diffuse_name(o.diffuse),
             specular_name(o.specular),
             fresnel_name(o.fresnel),
@@ -158,7 +173,13 @@ impl ViewState {
             if o.flags & ShadeOptions::DIRECT != 0 { "on" } else { "off" },
             self.exposure,
             tonemapper_name(self.tonemapper),
-            self.sky_blur
+            self.sky_blur,
+            match (self.spheres, self.show_model) {
+                (true, true) => " | grid + model",
+                (false, true) => " | model",
+                (true, false) => "",
+                (false, false) => " | sky only",
+            }
         )
     }
 
@@ -192,6 +213,8 @@ impl ViewState {
             shape,
             base_color: self.base_color.extend(1.0),
             lights,
+            view_proj: perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * look_at(eye, forward, right, up),
+            depth_range: Vec4::new(DEPTH_RANGE.0, DEPTH_RANGE.1, 0.0, 0.0),
         }
     }
 }
@@ -211,6 +234,7 @@ pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
 
 /// The scene pipeline and the baked buffers on the GPU.
 pub struct GpuScene {
+    layout: wgpu::BindGroupLayout,
     pipeline_layout: wgpu::PipelineLayout,
     pipelines: std::sync::Mutex<Vec<(wgpu::TextureFormat, wgpu::RenderPipeline)>>,
     frame_buffer: wgpu::Buffer,
@@ -225,7 +249,7 @@ impl GpuScene {
         let device = &gpu.device;
         let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
             binding,
-            visibility: wgpu::ShaderStages::FRAGMENT,
+            visibility: if binding == 0 { wgpu::ShaderStages::VERTEX_FRAGMENT } else { wgpu::ShaderStages::FRAGMENT },
             ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
             count: None,
         };
@@ -260,7 +284,7 @@ impl GpuScene {
                 wgpu::BindGroupEntry { binding: 4, resource: source.as_entire_binding() },
             ],
         });
-        Self { pipeline_layout, pipelines: Default::default(), frame_buffer, bind_group, shape: env.shape() }
+        Self { layout, pipeline_layout, pipelines: Default::default(), frame_buffer, bind_group, shape: env.shape() }
     }
 
     fn pipeline(&self, gpu: &Gpu, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
@@ -278,7 +302,13 @@ impl GpuScene {
                 buffers: &[],
             },
             primitive: wgpu::PrimitiveState::default(),
-            depth_stencil: None,
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
                 module: &gpu.module,
@@ -293,8 +323,18 @@ impl GpuScene {
         p
     }
 
-    /// Records drawing `frame` into `view` (of `format`).
-    pub fn draw(&self, gpu: &Gpu, encoder: &mut wgpu::CommandEncoder, view: &wgpu::TextureView, format: wgpu::TextureFormat, frame: &Frame) {
+    /// Records drawing `frame` into `view` (of `format`) with depth buffer `depth` (of
+    /// [`DEPTH_FORMAT`]): the spheres and sky, then `model` if any.
+    pub fn draw(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        frame: &Frame,
+        model: Option<&GpuModel>,
+    ) {
         gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(frame));
         let pipeline = self.pipeline(gpu, format);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -305,7 +345,11 @@ impl GpuScene {
                 resolve_target: None,
                 ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
             })],
-            depth_stencil_attachment: None,
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
@@ -313,10 +357,36 @@ impl GpuScene {
         pass.set_pipeline(&pipeline);
         pass.set_bind_group(1, &self.bind_group, &[]);
         pass.draw(0..3, 0..1);
+        if let Some(m) = model {
+            for p in &m.primitives {
+                pass.set_pipeline(&m.pipeline(gpu, self, format, p.double_sided));
+                pass.set_bind_group(1, &self.bind_group, &[]);
+                pass.set_bind_group(2, &p.bind_group, &[]);
+                pass.set_vertex_buffer(0, p.vertices.slice(..));
+                pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..p.count, 0, 0..1);
+            }
+        }
+    }
+
+    /// A depth buffer for a `width`×`height` target.
+    pub fn depth_texture(gpu: &Gpu, width: u32, height: u32) -> wgpu::TextureView {
+        gpu.device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("depth"),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
     }
 
     /// Renders `frame` offscreen into an RGBA32F texture and reads it back (row 0 at the top).
-    pub fn render_offscreen(&self, gpu: &Gpu, frame: &Frame) -> Result<Vec<Vec4>> {
+    pub fn render_offscreen(&self, gpu: &Gpu, frame: &Frame, model: Option<&GpuModel>) -> Result<Vec<Vec4>> {
         let (w, h) = (frame.viewport.x as u32, frame.viewport.y as u32);
         let format = wgpu::TextureFormat::Rgba32Float;
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
@@ -330,8 +400,9 @@ impl GpuScene {
             view_formats: &[],
         });
         let view = texture.create_view(&Default::default());
+        let depth = Self::depth_texture(gpu, w, h);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        self.draw(gpu, &mut encoder, &view, format, frame);
+        self.draw(gpu, &mut encoder, &view, &depth, format, frame, model);
         let row = (w as u64 * 16).div_ceil(256) * 256;
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("offscreen readback"),
@@ -356,6 +427,204 @@ impl GpuScene {
         }
         Ok(out)
     }
+}
+
+/// Right-handed perspective projection with depth in [0, 1]: view-space `z = −near` maps
+/// to 0 and `−far` to 1 (the projection `surface::depth` assumes).
+pub fn perspective(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
+    let h = 1.0 / (0.5 * fov_y).tan();
+    let r = far / (near - far);
+    Mat4::from_cols(
+        Vec4::new(h / aspect, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, h, 0.0, 0.0),
+        Vec4::new(0.0, 0.0, r, -1.0),
+        Vec4::new(0.0, 0.0, r * near, 0.0),
+    )
+}
+
+/// World to view space for a camera at `eye` with orthonormal `forward`, `right`, `up`.
+pub fn look_at(eye: Vec3, forward: Vec3, right: Vec3, up: Vec3) -> Mat4 {
+    Mat4::from_cols(
+        Vec4::new(right.x, up.x, -forward.x, 0.0),
+        Vec4::new(right.y, up.y, -forward.y, 0.0),
+        Vec4::new(right.z, up.z, -forward.z, 0.0),
+        Vec4::new(-right.dot(eye), -up.dot(eye), forward.dot(eye), 1.0),
+    )
+}
+
+/// Depth buffer format of the display.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Near and far planes of the camera.
+pub const DEPTH_RANGE: (f32, f32) = (0.05, 500.0);
+
+/// One primitive of a model on the GPU.
+pub struct GpuPrimitive {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    count: u32,
+    bind_group: wgpu::BindGroup,
+    double_sided: bool,
+}
+
+/// A glTF model on the GPU: buffers, textures (with mipmaps) and the mesh pipelines.
+pub struct GpuModel {
+    primitives: Vec<GpuPrimitive>,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: std::sync::Mutex<Vec<(wgpu::TextureFormat, bool, wgpu::RenderPipeline)>>,
+}
+
+impl GpuModel {
+    /// Uploads `model` for drawing with `scene`.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, model: &Model) -> Self {
+        let device = &gpu.device;
+        let mut entries = vec![wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        }];
+        for b in 1..=SLOTS as u32 {
+            entries.push(wgpu::BindGroupLayoutEntry {
+                binding: b,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            });
+        }
+        entries.push(wgpu::BindGroupLayoutEntry {
+            binding: SLOTS as u32 + 1,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            count: None,
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("mesh material"), entries: &entries });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mesh layout"),
+            bind_group_layouts: &[None, Some(&scene.layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("mesh textures"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let white = Texture { width: 1, height: 1, rgba: vec![255; 4], srgb: false };
+        let primitives = model
+            .primitives
+            .iter()
+            .map(|p| {
+                let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("mesh material"),
+                    contents: bytemuck::bytes_of(&p.material),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let views: Vec<wgpu::TextureView> =
+                    p.textures.iter().map(|t| upload_texture(gpu, t.as_ref().unwrap_or(&white))).collect();
+                let mut group = vec![wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }];
+                for (k, v) in views.iter().enumerate() {
+                    group.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: wgpu::BindingResource::TextureView(v) });
+                }
+                group.push(wgpu::BindGroupEntry { binding: SLOTS as u32 + 1, resource: wgpu::BindingResource::Sampler(&sampler) });
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("mesh"), layout: &layout, entries: &group });
+                GpuPrimitive {
+                    vertices: gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("vertices"),
+                        contents: bytemuck::cast_slice(&p.vertices),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    }),
+                    indices: gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("indices"),
+                        contents: bytemuck::cast_slice(&p.indices),
+                        usage: wgpu::BufferUsages::INDEX,
+                    }),
+                    count: p.indices.len() as u32,
+                    bind_group,
+                    double_sided: p.double_sided,
+                }
+            })
+            .collect();
+        Self { primitives, pipeline_layout, pipelines: Default::default() }
+    }
+
+    fn pipeline(&self, gpu: &Gpu, _scene: &GpuScene, format: wgpu::TextureFormat, double_sided: bool) -> wgpu::RenderPipeline {
+        let mut cache = self.pipelines.lock().expect("pipeline cache");
+        if let Some((_, _, p)) = cache.iter().find(|(f, d, _)| *f == format && *d == double_sided) {
+            return p.clone();
+        }
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2];
+        let p = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("mesh"),
+            layout: Some(&self.pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &gpu.module,
+                entry_point: Some("display::mesh_vs"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: if double_sided { None } else { Some(wgpu::Face::Back) },
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &gpu.module,
+                entry_point: Some("display::mesh_fs"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        cache.push((format, double_sided, p.clone()));
+        p
+    }
+}
+
+/// Uploads an RGBA8 texture with its mip chain (box filter; sRGB textures averaged in
+/// linear light) and returns a view of it.
+fn upload_texture(gpu: &Gpu, t: &Texture) -> wgpu::TextureView {
+    let levels = crate::texture::mip_chain_rgba8(t.width, t.height, &t.rgba, t.srgb);
+    let format = if t.srgb { wgpu::TextureFormat::Rgba8UnormSrgb } else { wgpu::TextureFormat::Rgba8Unorm };
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("mesh texture"),
+        size: wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: 1 },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (level, (w, h, data)) in levels.iter().enumerate() {
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: level as u32, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            data,
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(*h) },
+            wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
+        );
+    }
+    texture.create_view(&Default::default())
 }
 
 /// Display values in [0, 1] to 8-bit RGB.

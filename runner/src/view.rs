@@ -4,7 +4,8 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
-use crate::render::{BakedEnvironment, GpuScene, ViewState};
+use crate::model::Model;
+use crate::render::{BakedEnvironment, GpuModel, GpuScene, ViewState};
 use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
 use splitsum_shaders::tonemap::Tonemapper;
 use std::path::PathBuf;
@@ -25,6 +26,7 @@ F  Fresnel form (Schlick, spherical Gaussian)
 I  image-based light on/off      L  direct lights on/off
 + -  exposure ±½ stop            T  tone curve (ACES, Reinhard, clamp)
 [ ]  sky blur ±½ mip             R  reset the camera
+G  sphere grid on/off            M  model on/off
 P  save a screenshot (PNG)       H  this help          Esc/Q  quit";
 
 /// How the viewer runs.
@@ -48,6 +50,8 @@ pub fn display_available() -> bool {
 struct App {
     gpu: Gpu,
     scene: GpuScene,
+    model: Option<GpuModel>,
+    depth: Option<(u32, u32, wgpu::TextureView)>,
     state: ViewState,
     initial: ViewState,
     options: ViewOptions,
@@ -97,8 +101,13 @@ impl App {
         };
         let view = texture.texture.create_view(&Default::default());
         let frame = self.state.frame(self.scene.shape, config.width, config.height, self.encode_srgb);
+        if self.depth.as_ref().is_none_or(|(w, h, _)| (*w, *h) != (config.width, config.height)) {
+            self.depth = Some((config.width, config.height, GpuScene::depth_texture(&self.gpu, config.width, config.height)));
+        }
+        let depth = &self.depth.as_ref().expect("created above").2;
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        self.scene.draw(&self.gpu, &mut encoder, &view, config.format, &frame);
+        let model = self.model.as_ref().filter(|_| self.state.show_model);
+        self.scene.draw(&self.gpu, &mut encoder, &view, depth, config.format, &frame, model);
         self.gpu.queue.submit([encoder.finish()]);
         self.gpu.queue.present(texture);
         self.frames += 1;
@@ -122,7 +131,7 @@ impl App {
         let frame = self.state.frame(self.scene.shape, w, h, true);
         let result = self
             .scene
-            .render_offscreen(&self.gpu, &frame)
+            .render_offscreen(&self.gpu, &frame, self.model.as_ref().filter(|_| self.state.show_model))
             .and_then(|p| crate::files::write_png(&path, w, h, &crate::render::to_rgb8(&p)));
         match result {
             Ok(()) => println!("wrote {}", path.display()),
@@ -155,7 +164,15 @@ impl App {
                 "r" => {
                     self.state.yaw = self.initial.yaw;
                     self.state.pitch = self.initial.pitch;
-                    self.state.distance = self.initial.distance;
+                    self.state.frame_contents();
+                }
+                "g" => {
+                    self.state.spheres = !self.state.spheres;
+                    self.state.frame_contents();
+                }
+                "m" if self.model.is_some() => {
+                    self.state.show_model = !self.state.show_model;
+                    self.state.frame_contents();
                 }
                 "p" => self.screenshot(),
                 "h" => println!("{HELP}"),
@@ -272,8 +289,8 @@ impl ApplicationHandler for App {
     }
 }
 
-/// Opens a window on `gpu` showing `env` and runs until it is closed.
-pub fn run(gpu: Gpu, env: &BakedEnvironment, state: ViewState, options: ViewOptions) -> Result<()> {
+/// Opens a window on `gpu` showing `env` (and `model`, if any) and runs until it is closed.
+pub fn run(gpu: Gpu, env: &BakedEnvironment, model: Option<&Model>, state: ViewState, options: ViewOptions) -> Result<()> {
     let mut builder = EventLoop::builder();
     #[cfg(all(unix, not(target_os = "macos")))]
     {
@@ -285,10 +302,13 @@ pub fn run(gpu: Gpu, env: &BakedEnvironment, state: ViewState, options: ViewOpti
     }
     let event_loop = builder.build().map_err(|e| Error::Gpu(format!("no display to open a window on ({e}); use `runner render` instead")))?;
     let scene = GpuScene::new(&gpu, env);
+    let model = model.map(|m| GpuModel::new(&gpu, &scene, m));
     println!("{HELP}");
     let mut app = App {
         gpu,
         scene,
+        model,
+        depth: None,
         initial: state.clone(),
         state,
         options,

@@ -25,6 +25,7 @@ pub mod prefilter;
 pub mod sampling;
 pub mod scene;
 pub mod shade;
+pub mod surface;
 pub mod tonemap;
 
 pub use spirv_std::glam;

@@ -10,7 +10,7 @@ use crate::cubemap::{self, CubeLayout};
 use crate::shade::{self, EnvironmentShape, Material, ShadeOptions};
 use crate::{math, sampling, tonemap};
 use bytemuck::{Pod, Zeroable};
-use spirv_std::glam::{UVec4, Vec2, Vec3, Vec4};
+use spirv_std::glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 
 /// Most direct lights in a frame.
 pub const MAX_LIGHTS: usize = 4;
@@ -54,6 +54,10 @@ pub struct Frame {
     pub base_color: Vec4,
     /// Direct lights; the first `grid.w` are used.
     pub lights: [Light; MAX_LIGHTS],
+    /// World to clip space of the camera (for rasterised meshes and the depth of ray hits).
+    pub view_proj: Mat4,
+    /// Near and far planes of the projection.
+    pub depth_range: Vec4,
 }
 
 impl Frame {
@@ -169,8 +173,9 @@ pub fn shade_point(frame: &Frame, specular: &[Vec4], irradiance: &[Vec4], table:
     color
 }
 
-/// Linear radiance seen through pixel position `px`: a sphere of the grid, or the sky.
-pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> Vec3 {
+/// Linear radiance seen through pixel position `px` (a sphere of the grid, or the sky) and
+/// its depth in [0, 1] (1 for the sky).
+pub fn radiance_depth(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> (Vec3, f32) {
     let origin = frame.eye.truncate();
     let dir = camera_ray(frame, px);
     if frame.flags.x & Frame::SPHERES != 0 {
@@ -179,10 +184,17 @@ pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &
             let p = origin + dir * t;
             let n = sampling::normalize_or(p - sphere_centre(row, col, frame.grid.x, frame.grid.y), -dir);
             let m = grid_material(frame, row, col);
-            return shade_point(frame, specular, irradiance, table, &m, p, n, -dir);
+            let d = (p - origin).dot(frame.forward.truncate());
+            let depth = crate::surface::depth(d, frame.depth_range.x, frame.depth_range.y);
+            return (shade_point(frame, specular, irradiance, table, &m, p, n, -dir), depth);
         }
     }
-    sky(frame, source, specular, dir)
+    (sky(frame, source, specular, dir), 1.0)
+}
+
+/// Linear radiance seen through pixel position `px`.
+pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> Vec3 {
+    radiance_depth(frame, source, specular, irradiance, table, px).0
 }
 
 /// The sky along `dir`: the source cube when the blur is 0, else the specular cube at the

@@ -60,6 +60,13 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     if x <= 0.003_130_8 { 12.92 * x } else { 1.055 * math::pow(x, 1.0 / 2.4) - 0.055 }
 }
 
+/// The linear value of an sRGB-encoded value in [0, 1].
+#[inline]
+pub fn srgb_to_linear(x: f32) -> f32 {
+    let x = math::saturate(x);
+    if x <= 0.040_45 { x / 12.92 } else { math::pow((x + 0.055) / 1.055, 2.4) }
+}
+
 /// Exposure that maps log-average luminance `log_average` to middle grey (key 0.18).
 #[inline]
 pub fn key_exposure(log_average: f32) -> f32 {

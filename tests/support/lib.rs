@@ -3,6 +3,7 @@
 //! the GPU backend opened once per test binary.
 
 pub mod quadrature;
+pub mod model;
 pub mod reference;
 
 use runner::{Backend, BackendKind};

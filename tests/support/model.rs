@@ -1,0 +1,187 @@
+//! A procedural glTF 2.0 test model: a torus with all five metallic–roughness texture
+//! slots filled (base colour checker, roughness ramp and metal cells, dimpled normal map,
+//! grooves in the occlusion, glowing dots), a node transform, written as a `.glb`.
+//! `assets/models/torus.glb` is this output (checked by a test).
+
+use std::f32::consts::TAU;
+
+const SIZE: u32 = 128;
+const CELLS: u32 = 8;
+
+fn png(w: u32, h: u32, f: impl Fn(u32, u32) -> [u8; 3]) -> Vec<u8> {
+    let mut img = image::RgbImage::new(w, h);
+    for y in 0..h {
+        for x in 0..w {
+            img.put_pixel(x, y, image::Rgb(f(x, y)));
+        }
+    }
+    let mut out = std::io::Cursor::new(Vec::new());
+    img.write_to(&mut out, image::ImageFormat::Png).unwrap();
+    out.into_inner()
+}
+
+/// Position in the cell grid: cell index and offset from the cell centre in [−½, ½].
+fn cell(x: u32, y: u32) -> (u32, u32, f32, f32) {
+    let c = SIZE / CELLS;
+    let (cx, cy) = (x / c, y / c);
+    let fx = ((x % c) as f32 + 0.5) / c as f32 - 0.5;
+    let fy = ((y % c) as f32 + 0.5) / c as f32 - 0.5;
+    (cx, cy, fx, fy)
+}
+
+fn textures() -> [Vec<u8>; 5] {
+    let base = png(SIZE, SIZE, |x, y| {
+        let (cx, cy, _, _) = cell(x, y);
+        if (cx + cy) % 2 == 0 { [235, 220, 190] } else { [30, 110, 120] }
+    });
+    let mr = png(SIZE, SIZE, |x, y| {
+        let (cx, cy, _, _) = cell(x, y);
+        let rough = (20 + 215 * x / (SIZE - 1)) as u8;
+        let metal = if (cx + cy) % 2 == 1 { 255 } else { 0 };
+        [0, rough, metal]
+    });
+    let normal = png(SIZE, SIZE, |x, y| {
+        let (_, _, fx, fy) = cell(x, y);
+        let r2 = fx * fx + fy * fy;
+        // A spherical dimple of radius 0.4 cell in each cell.
+        let (nx, ny) = if r2 < 0.16 { (fx * 1.5, fy * 1.5) } else { (0.0, 0.0) };
+        let nz = (1.0 - nx * nx - ny * ny).max(0.0).sqrt();
+        [nx, ny, nz].map(|v| ((v * 0.5 + 0.5) * 255.0).round() as u8)
+    });
+    let occlusion = png(SIZE, SIZE, |x, y| {
+        let (_, _, fx, fy) = cell(x, y);
+        let edge = fx.abs().max(fy.abs());
+        let v = if edge > 0.42 { 110 } else { 255 };
+        [v, v, v]
+    });
+    let emissive = png(SIZE, SIZE, |x, y| {
+        let (cx, cy, fx, fy) = cell(x, y);
+        if (cx + 2 * cy) % 5 == 0 && fx * fx + fy * fy < 0.02 { [255, 140, 40] } else { [0, 0, 0] }
+    });
+    [base, mr, normal, occlusion, emissive]
+}
+
+/// The torus: positions, normals, tangents, uvs and CCW-outward triangles.
+#[allow(clippy::type_complexity)]
+fn torus() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 4]>, Vec<[f32; 2]>, Vec<u32>) {
+    let (nu, nv) = (64u32, 32u32);
+    let (big, small) = (1.0f32, 0.4f32);
+    let (mut p, mut n, mut t, mut uv) = (vec![], vec![], vec![], vec![]);
+    for j in 0..=nv {
+        for i in 0..=nu {
+            let (su, cu) = (TAU * i as f32 / nu as f32).sin_cos();
+            let (sv, cv) = (TAU * j as f32 / nv as f32).sin_cos();
+            p.push([(big + small * cv) * cu, small * sv, (big + small * cv) * su]);
+            let normal = [cv * cu, sv, cv * su];
+            n.push(normal);
+            // Tangent along +s (increasing u), bitangent along +t (increasing v).
+            let tan = [-su, 0.0, cu];
+            let bit = [-sv * cu, cv, -sv * su];
+            let cross = [
+                normal[1] * tan[2] - normal[2] * tan[1],
+                normal[2] * tan[0] - normal[0] * tan[2],
+                normal[0] * tan[1] - normal[1] * tan[0],
+            ];
+            let w = if cross[0] * bit[0] + cross[1] * bit[1] + cross[2] * bit[2] < 0.0 { -1.0 } else { 1.0 };
+            t.push([tan[0], tan[1], tan[2], w]);
+            uv.push([3.0 * i as f32 / nu as f32, j as f32 / nv as f32]);
+        }
+    }
+    let mut idx = Vec::new();
+    let at = |i: u32, j: u32| j * (nu + 1) + i;
+    for j in 0..nv {
+        for i in 0..nu {
+            for tri in [[at(i, j), at(i + 1, j), at(i + 1, j + 1)], [at(i, j), at(i + 1, j + 1), at(i, j + 1)]] {
+                // Orient counter-clockwise seen from outside.
+                let [a, b, c] = tri.map(|k| p[k as usize]);
+                let e1 = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+                let e2 = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+                let f = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
+                let nn = n[tri[0] as usize];
+                if f[0] * nn[0] + f[1] * nn[1] + f[2] * nn[2] < 0.0 {
+                    idx.extend([tri[0], tri[2], tri[1]]);
+                } else {
+                    idx.extend(tri);
+                }
+            }
+        }
+    }
+    (p, n, t, uv, idx)
+}
+
+/// The `.glb` bytes of the test model.
+pub fn sample_glb() -> Vec<u8> {
+    let (p, n, t, uv, idx) = torus();
+    let mut bin: Vec<u8> = Vec::new();
+    let mut views = Vec::new();
+    let mut push = |bytes: &[u8], bin: &mut Vec<u8>| {
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        views.push(serde_json::json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}));
+        bin.extend_from_slice(bytes);
+        views.len() - 1
+    };
+    let f32s = |v: &[f32]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
+    let vp = push(&f32s(&p.concat()), &mut bin);
+    let vn = push(&f32s(&n.concat()), &mut bin);
+    let vt = push(&f32s(&t.concat()), &mut bin);
+    let vu = push(&f32s(&uv.concat()), &mut bin);
+    let vi = push(&idx.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>(), &mut bin);
+    let images: Vec<usize> = textures().iter().map(|png| push(png, &mut bin)).collect();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let (lo, hi) = p.iter().fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), q| {
+        ([lo[0].min(q[0]), lo[1].min(q[1]), lo[2].min(q[2])], [hi[0].max(q[0]), hi[1].max(q[1]), hi[2].max(q[2])])
+    });
+    let count = p.len();
+    let json = serde_json::json!({
+        "asset": {"version": "2.0", "generator": "splitsum tests/support/model.rs"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        // Tilted a quarter turn about x and scaled: node transforms must be applied.
+        "nodes": [{"mesh": 0, "rotation": [0.5, 0.0, 0.0, 0.866_025_4], "scale": [2.0, 2.0, 2.0]}],
+        "meshes": [{"primitives": [{
+            "attributes": {"POSITION": 0, "NORMAL": 1, "TANGENT": 2, "TEXCOORD_0": 3},
+            "indices": 4, "material": 0
+        }]}],
+        "materials": [{
+            "name": "checker",
+            "pbrMetallicRoughness": {
+                "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "baseColorTexture": {"index": 0},
+                "metallicFactor": 1.0, "roughnessFactor": 1.0, "metallicRoughnessTexture": {"index": 1}
+            },
+            "normalTexture": {"index": 2, "scale": 1.0},
+            "occlusionTexture": {"index": 3, "strength": 1.0},
+            "emissiveTexture": {"index": 4}, "emissiveFactor": [4.0, 4.0, 4.0]
+        }],
+        "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497}],
+        "textures": (0..5).map(|k| serde_json::json!({"source": k, "sampler": 0})).collect::<Vec<_>>(),
+        "images": images.iter().map(|&v| serde_json::json!({"bufferView": v, "mimeType": "image/png"})).collect::<Vec<_>>(),
+        "accessors": [
+            {"bufferView": vp, "componentType": 5126, "count": count, "type": "VEC3", "min": lo, "max": hi},
+            {"bufferView": vn, "componentType": 5126, "count": count, "type": "VEC3"},
+            {"bufferView": vt, "componentType": 5126, "count": count, "type": "VEC4"},
+            {"bufferView": vu, "componentType": 5126, "count": count, "type": "VEC2"},
+            {"bufferView": vi, "componentType": 5125, "count": idx.len(), "type": "SCALAR"}
+        ],
+        "bufferViews": views,
+        "buffers": [{"byteLength": bin.len()}]
+    });
+    let mut text = serde_json::to_vec(&json).unwrap();
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let mut glb = Vec::new();
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&((12 + 8 + text.len() + 8 + bin.len()) as u32).to_le_bytes());
+    glb.extend_from_slice(&(text.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&text);
+    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"BIN\0");
+    glb.extend_from_slice(&bin);
+    glb
+}
