@@ -1,14 +1,23 @@
 //! The two ways to bake: on a GPU through wgpu, or natively on the CPU. Both call the same
 //! `splitsum_shaders` functions; this module hides which one runs.
+//!
+//! On the GPU, long sums run one chunk of at most `math::CHUNK` terms per dispatch and
+//! carry compensated partial sums from dispatch to dispatch; the final means are resolved
+//! here with the same shared functions the CPU backend ends with, so both backends do the
+//! same arithmetic in the same order.
 
 use crate::cpu;
 use crate::error::{Error, Result};
 use crate::gpu::{self, Dispatch, Gpu, Kernel};
 use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
-use splitsum_shaders::glam::{Vec2, Vec4};
+use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
-use splitsum_shaders::kernels::{self, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams};
+use splitsum_shaders::kernels::{
+    self, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, probe_mode,
+};
+use splitsum_shaders::math::{CHUNK, MeanPartial};
+use splitsum_shaders::{equirect, lut, prefilter};
 
 /// Which backend to bake with.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -25,6 +34,34 @@ pub enum Backend {
     Gpu(Box<Gpu>),
     /// The CPU.
     Cpu,
+}
+
+/// The chunks `(start, count)` a sum of `n` terms is split into (see `math::CHUNK`).
+pub fn chunks(n: u32) -> impl Iterator<Item = (u32, u32)> {
+    let n = n.max(1);
+    (0..n.div_ceil(CHUNK)).map(move |k| (k * CHUNK, CHUNK.min(n - k * CHUNK)))
+}
+
+fn read_vec4(g: &Gpu, buffer: &wgpu::Buffer, count: u32) -> Result<Vec<Vec4>> {
+    let bytes = g.read(buffer)?;
+    Ok(bytemuck::pod_collect_to_vec(&bytes[..count as usize * 16]))
+}
+
+fn partial(sums: &[Vec4], texel: usize) -> MeanPartial {
+    MeanPartial { sum: sums[3 * texel], carry: sums[3 * texel + 1], weight: sums[3 * texel + 2] }
+}
+
+/// Largest BRDF table accepted (a 4096² table is 128 MiB; beyond that nothing gains).
+pub const MAX_LUT_SIZE: u32 = 4096;
+
+fn check_lut_args(size: u32, samples: u32) -> Result<()> {
+    if size == 0 || size > MAX_LUT_SIZE {
+        return Err(Error::Invalid(format!("--size must be between 1 and {MAX_LUT_SIZE}, not {size}")));
+    }
+    if samples == 0 {
+        return Err(Error::Invalid("--samples must be at least 1".into()));
+    }
+    Ok(())
 }
 
 impl Backend {
@@ -47,62 +84,77 @@ impl Backend {
     /// The `size`×`size` BRDF table from `samples` points per texel.
     pub fn brdf_lut(&self, size: u32, samples: u32) -> Result<Lut> {
         check_lut_args(size, samples)?;
-        match self {
-            Backend::Cpu => Ok(cpu::brdf_lut(size, samples)),
-            Backend::Gpu(g) => {
-                let out = g.output("brdf lut", size as u64 * size as u64 * 8)?;
-                // Rows per submission: about 2²⁶ sample evaluations each, so that no single
-                // submission runs long enough to trip a display driver's watchdog.
-                let rows = ((1u64 << 26) / (size as u64 * samples as u64)).clamp(8, size as u64) as u32;
-                let rows = rows.div_ceil(kernels::TILE) * kernels::TILE;
-                let mut row = 0;
-                while row < size {
-                    let p = LutParams { size, samples, row_offset: row, pad: 0 };
-                    let n = rows.min(size - row);
-                    g.run(&[Dispatch {
-                        kernel: Kernel::BrdfLut,
-                        params: bytemuck::bytes_of(&p),
-                        input: None,
-                        output: &out,
-                        groups: [gpu::groups(size, kernels::TILE), gpu::groups(n, kernels::TILE), 1],
-                    }]);
-                    row += n;
-                }
-                let bytes = g.read(&out)?;
-                let texels: Vec<Vec2> = bytemuck::pod_collect_to_vec(&bytes[..(size * size * 8) as usize]);
-                Ok(Lut { size, texels })
+        let g = match self {
+            Backend::Cpu => return Ok(cpu::brdf_lut(size, samples)),
+            Backend::Gpu(g) => g,
+        };
+        let n = size as u64 * size as u64;
+        let accum = g.output("brdf lut sums", n * 16)?;
+        // Rows per submission: about 2²⁶ sample evaluations each, so that no single
+        // submission runs long enough to trip a display driver's watchdog.
+        let per_row = size as u64 * samples.min(CHUNK) as u64;
+        let rows = ((1u64 << 26) / per_row).clamp(8, size as u64) as u32;
+        let rows = rows.div_ceil(kernels::TILE) * kernels::TILE;
+        for (start, count) in chunks(samples) {
+            let mut row = 0;
+            while row < size {
+                let p = LutParams { size, samples, row_offset: row, start, count, pad0: 0, pad1: 0, pad2: 0 };
+                let h = rows.min(size - row);
+                g.run(&[Dispatch {
+                    kernel: Kernel::BrdfLut,
+                    params: bytemuck::bytes_of(&p),
+                    input: None,
+                    output: &accum,
+                    groups: [gpu::groups(size, kernels::TILE), gpu::groups(h, kernels::TILE), 1],
+                }]);
+                row += h;
             }
         }
+        let sums = read_vec4(g, &accum, n as u32)?;
+        Ok(Lut { size, texels: sums.iter().map(|&st| lut::resolve(st, samples)).collect() })
     }
-}
 
-impl Backend {
     /// The source cube: `env` resampled to faces of `size` with `supersample`² points per
     /// texel, and its full mip chain.
     pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Cube> {
-        match self {
+        let g = match self {
             Backend::Cpu => {
                 let mut cube = cpu::equirect_to_cube(env, size, supersample);
                 cpu::build_mips(&mut cube);
-                Ok(cube)
+                return Ok(cube);
             }
-            Backend::Gpu(g) => {
-                let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
-                let src = g.upload("equirect", bytemuck::cast_slice(&env.texels));
-                let out = g.output("source cube", layout.texel_count() as u64 * 16)?;
-                let p = EquirectParams { width: env.width, height: env.height, face_size: size, supersample };
-                let tile = gpu::groups(size, kernels::TILE);
-                g.run(&[Dispatch {
-                    kernel: Kernel::EquirectToCube,
-                    params: bytemuck::bytes_of(&p),
-                    input: Some(&src),
-                    output: &out,
-                    groups: [tile, tile, FACES],
-                }]);
-                self.gpu_mips(g, &out, layout);
-                Ok(Cube { layout, texels: read_vec4(g, &out, layout.texel_count())? })
-            }
-        }
+            Backend::Gpu(g) => g,
+        };
+        let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
+        let (w, h) = (env.width, env.height);
+        let levels = equirect::pyramid_levels(w);
+        let mut texels = env.texels.clone();
+        texels.resize(equirect::pyramid_len(w, h) as usize, Vec4::ZERO);
+        let pyramid = g.upload("equirect pyramid", bytemuck::cast_slice(&texels));
+        let base = EquirectParams { width: w, height: h, face_size: size, supersample, levels, level: 0, pad0: 0, pad1: 0 };
+        let params: Vec<EquirectParams> = (1..levels).map(|level| EquirectParams { level, ..base }).collect();
+        let dispatches: Vec<Dispatch> = params
+            .iter()
+            .map(|p| Dispatch {
+                kernel: Kernel::EquirectPyramid,
+                params: bytemuck::bytes_of(p),
+                input: None,
+                output: &pyramid,
+                groups: [gpu::groups(w >> p.level, kernels::TILE), gpu::groups(h, kernels::TILE), 1],
+            })
+            .collect();
+        g.run(&dispatches);
+        let out = g.output("source cube", layout.texel_count() as u64 * 16)?;
+        let tile = gpu::groups(size, kernels::TILE);
+        g.run(&[Dispatch {
+            kernel: Kernel::EquirectToCube,
+            params: bytemuck::bytes_of(&base),
+            input: Some(&pyramid),
+            output: &out,
+            groups: [tile, tile, FACES],
+        }]);
+        self.gpu_mips(g, &out, layout);
+        Ok(Cube { layout, texels: read_vec4(g, &out, layout.texel_count())? })
     }
 
     /// Fills levels 1.. of `cube` from its level 0.
@@ -138,57 +190,96 @@ impl Backend {
         if samples == 0 {
             return Err(Error::Invalid("--samples must be at least 1".into()));
         }
-        match self {
-            Backend::Cpu => Ok(cpu::prefilter(src, out, roughness, samples, lod_bias)),
-            Backend::Gpu(g) => {
-                let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
-                let dst = g.output("specular cube", out.texel_count() as u64 * 16)?;
-                for m in 0..out.levels {
-                    let s = out.level_size(m);
-                    let p = PrefilterParams {
-                        src_size: src.layout.size,
-                        src_levels: src.layout.levels,
-                        dst_size: s,
-                        samples,
-                        roughness: roughness[m as usize],
-                        lod_bias,
-                        dst_offset: out.level_offset(m),
-                        pad: 0,
-                    };
-                    let t = gpu::groups(s, kernels::TILE);
-                    g.run(&[Dispatch {
-                        kernel: Kernel::PrefilterSpecular,
-                        params: bytemuck::bytes_of(&p),
-                        input: Some(&input),
-                        output: &dst,
-                        groups: [t, t, FACES],
-                    }]);
-                }
-                Ok(Cube { layout: out, texels: read_vec4(g, &dst, out.texel_count())? })
+        let g = match self {
+            Backend::Cpu => return Ok(cpu::prefilter(src, out, roughness, samples, lod_bias)),
+            Backend::Gpu(g) => g,
+        };
+        let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
+        let accum = g.output("specular sums", out.texel_count() as u64 * 48)?;
+        for m in 0..out.levels {
+            let r = roughness[m as usize];
+            if r <= 0.0 {
+                continue; // a mirror: resolved from the source below
+            }
+            let s = out.level_size(m);
+            let t = gpu::groups(s, kernels::TILE);
+            for (start, count) in chunks(samples) {
+                let p = PrefilterParams {
+                    src_size: src.layout.size,
+                    src_levels: src.layout.levels,
+                    dst_size: s,
+                    samples,
+                    roughness: r,
+                    lod_bias,
+                    dst_offset: out.level_offset(m),
+                    start,
+                    count,
+                    pad0: 0,
+                    pad1: 0,
+                    pad2: 0,
+                };
+                g.run(&[Dispatch {
+                    kernel: Kernel::PrefilterSpecular,
+                    params: bytemuck::bytes_of(&p),
+                    input: Some(&input),
+                    output: &accum,
+                    groups: [t, t, FACES],
+                }]);
             }
         }
+        let sums = read_vec4(g, &accum, 3 * out.texel_count())?;
+        let mut texels = Vec::with_capacity(out.texel_count() as usize);
+        for m in 0..out.levels {
+            let s = out.level_size(m);
+            let r = roughness[m as usize];
+            for face in 0..FACES {
+                for y in 0..s {
+                    for x in 0..s {
+                        texels.push(if r <= 0.0 {
+                            prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples, lod_bias)
+                        } else {
+                            partial(&sums, out.index(m, face, x, y) as usize).resolve()
+                        });
+                    }
+                }
+            }
+        }
+        Ok(Cube { layout: out, texels })
     }
 
     /// The irradiance cube (`E/π`) of face size `size` from level `level` of `src`.
     pub fn irradiance(&self, src: &Cube, level: u32, size: u32) -> Result<Cube> {
-        match self {
-            Backend::Cpu => Ok(cpu::irradiance(src, level, size)),
-            Backend::Gpu(g) => {
-                let layout = CubeLayout::new(size, 1);
-                let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
-                let dst = g.output("irradiance cube", layout.texel_count() as u64 * 16)?;
-                let p = IrradianceParams { src_size: src.layout.size, src_levels: src.layout.levels, src_level: level, dst_size: size };
-                let t = gpu::groups(size, kernels::TILE);
-                g.run(&[Dispatch {
-                    kernel: Kernel::IrradianceCube,
-                    params: bytemuck::bytes_of(&p),
-                    input: Some(&input),
-                    output: &dst,
-                    groups: [t, t, FACES],
-                }]);
-                Ok(Cube { layout, texels: read_vec4(g, &dst, layout.texel_count())? })
-            }
+        let g = match self {
+            Backend::Cpu => return Ok(cpu::irradiance(src, level, size)),
+            Backend::Gpu(g) => g,
+        };
+        let layout = CubeLayout::new(size, 1);
+        let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
+        let accum = g.output("irradiance sums", layout.texel_count() as u64 * 48)?;
+        let s = src.layout.level_size(level);
+        let t = gpu::groups(size, kernels::TILE);
+        for (start, count) in chunks(FACES * s * s) {
+            let p = IrradianceParams {
+                src_size: src.layout.size,
+                src_levels: src.layout.levels,
+                src_level: level,
+                dst_size: size,
+                start,
+                count,
+                pad0: 0,
+                pad1: 0,
+            };
+            g.run(&[Dispatch {
+                kernel: Kernel::IrradianceCube,
+                params: bytemuck::bytes_of(&p),
+                input: Some(&input),
+                output: &accum,
+                groups: [t, t, FACES],
+            }]);
         }
+        let sums = read_vec4(g, &accum, 3 * layout.texel_count())?;
+        let texels = (0..layout.texel_count() as usize).map(|i| partial(&sums, i).resolve()).collect();
+        Ok(Cube { layout, texels })
     }
 
     /// The nine SH coefficients of radiance of level `level` of `src`.
@@ -200,7 +291,16 @@ impl Backend {
                 let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
                 let n = FACES * s * (SH9 as u32 + 1);
                 let dst = g.output("sh9 rows", n as u64 * 16)?;
-                let p = IrradianceParams { src_size: src.layout.size, src_levels: src.layout.levels, src_level: level, dst_size: 0 };
+                let p = IrradianceParams {
+                    src_size: src.layout.size,
+                    src_levels: src.layout.levels,
+                    src_level: level,
+                    dst_size: 0,
+                    start: 0,
+                    count: 0,
+                    pad0: 0,
+                    pad1: 0,
+                };
                 g.run(&[Dispatch {
                     kernel: Kernel::IrradianceSh9,
                     params: bytemuck::bytes_of(&p),
@@ -213,22 +313,66 @@ impl Backend {
         };
         Ok(Sh9::from_rows(&rows))
     }
-}
 
-fn read_vec4(g: &Gpu, buffer: &wgpu::Buffer, count: u32) -> Result<Vec<Vec4>> {
-    let bytes = g.read(buffer)?;
-    Ok(bytemuck::pod_collect_to_vec(&bytes[..count as usize * 16]))
-}
-
-/// Largest BRDF table accepted (a 4096² table is 128 MiB; beyond that nothing gains).
-pub const MAX_LUT_SIZE: u32 = 4096;
-
-fn check_lut_args(size: u32, samples: u32) -> Result<()> {
-    if size == 0 || size > MAX_LUT_SIZE {
-        return Err(Error::Invalid(format!("--size must be between 1 and {MAX_LUT_SIZE}, not {size}")));
+    /// Evaluates `probes` with `params` (see `kernels::probe_chunk`) over `cube`, if any:
+    /// the BRDF table `(A, B)` in `xy`, a prefiltered or irradiance mean, or a cube lookup.
+    pub fn probe(&self, params: ProbeParams, cube: Option<&Cube>, probes: &[Vec4]) -> Result<Vec<Vec4>> {
+        let texels: &[Vec4] = cube.map_or(&[], |c| &c.texels);
+        let p = ProbeParams {
+            count: probes.len() as u32,
+            probe_offset: texels.len() as u32,
+            src_size: cube.map_or(1, |c| c.layout.size),
+            src_levels: cube.map_or(1, |c| c.layout.levels),
+            ..params
+        };
+        let layout = CubeLayout::new(p.src_size, p.src_levels);
+        // Terms of the sum each probe runs, in chunks.
+        let terms = match p.mode {
+            probe_mode::LUT | probe_mode::PREFILTER => p.samples.max(1),
+            probe_mode::IRRADIANCE => FACES * layout.level_size(p.src_level).pow(2),
+            _ => 1,
+        };
+        let raw = match self {
+            Backend::Cpu => {
+                let mut out = vec![Vec4::ZERO; 3 * probes.len()];
+                for (i, &q) in probes.iter().enumerate() {
+                    for (start, chunk) in chunks(terms) {
+                        kernels::probe_chunk(&ProbeParams { start, chunk, ..p }, texels, q, &mut out, i);
+                    }
+                }
+                out
+            }
+            Backend::Gpu(g) => {
+                let mut input = texels.to_vec();
+                input.extend_from_slice(probes);
+                let buf = g.upload("probes", bytemuck::cast_slice(&input));
+                let out = g.output("probe results", probes.len() as u64 * 48)?;
+                for (start, chunk) in chunks(terms) {
+                    let pc = ProbeParams { start, chunk, ..p };
+                    g.run(&[Dispatch {
+                        kernel: Kernel::Probe,
+                        params: bytemuck::bytes_of(&pc),
+                        input: Some(&buf),
+                        output: &out,
+                        groups: [gpu::groups(p.count, 64), 1, 1],
+                    }]);
+                }
+                read_vec4(g, &out, 3 * p.count)?
+            }
+        };
+        Ok(raw
+            .chunks_exact(3)
+            .zip(probes)
+            .enumerate()
+            .map(|(i, (c, q))| match p.mode {
+                probe_mode::LUT => lut::resolve(c[0], p.samples).extend(0.0).extend(0.0),
+                // A mirror is no sum: the lookup itself.
+                probe_mode::PREFILTER if splitsum_shaders::math::saturate(q.w) <= 0.0 => {
+                    prefilter::prefilter_dir(texels, layout, q.truncate(), 0.0, p.samples, p.lod_bias)
+                }
+                probe_mode::PREFILTER | probe_mode::IRRADIANCE => partial(&raw, i).resolve(),
+                _ => c[0],
+            })
+            .collect())
     }
-    if samples == 0 {
-        return Err(Error::Invalid("--samples must be at least 1".into()));
-    }
-    Ok(())
 }

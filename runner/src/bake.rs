@@ -327,6 +327,8 @@ pub fn sh9_error(sh: &Sh9, irradiance: &Cube) -> ShError {
 pub struct InputSummary {
     /// Negative values set to 0.
     pub negative_texels: u64,
+    /// Values above 10²⁰ clamped.
+    pub clamped_texels: u64,
     /// NaN texels (replaced when sanitised).
     pub nan_texels: u64,
     /// Infinite texels (replaced when sanitised).
@@ -337,7 +339,7 @@ pub struct InputSummary {
 
 impl From<&InputReport> for InputSummary {
     fn from(r: &InputReport) -> Self {
-        Self { negative_texels: r.negative, nan_texels: r.nan, infinite_texels: r.infinite, max_value: r.max_value }
+        Self { negative_texels: r.negative, clamped_texels: r.clamped, nan_texels: r.nan, infinite_texels: r.infinite, max_value: r.max_value }
     }
 }
 

@@ -431,6 +431,9 @@ fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
     if input.negative > 0 {
         eprintln!("note: {}: {} texels had negative values, set to 0", args.env.display(), input.negative);
     }
+    if input.clamped > 0 {
+        eprintln!("note: {}: {} texels were brighter than 1e20 and were clamped to it", args.env.display(), input.clamped);
+    }
     if input.sanitized && (input.nan > 0 || input.infinite > 0) {
         eprintln!("note: {}: replaced {} NaN and {} infinite texels (--sanitize)", args.env.display(), input.nan, input.infinite);
     }

@@ -47,15 +47,36 @@ fn fill_level(out: &mut [Vec4], size: u32, bar: &ProgressBar, f: impl Fn(u32, u3
     });
 }
 
+/// The row pyramid of `env` (see `equirect::pyramid_texel`).
+pub fn equirect_pyramid(env: &Equirect) -> Vec<Vec4> {
+    let (w, h) = (env.width, env.height);
+    let mut pyramid = env.texels.clone();
+    pyramid.resize(equirect::pyramid_len(w, h) as usize, Vec4::ZERO);
+    for level in 1..equirect::pyramid_levels(w) {
+        let start = equirect::pyramid_offset(level, w, h) as usize;
+        let lw = (w >> level) as usize;
+        let (above, below) = pyramid.split_at_mut(start);
+        let src: &[Vec4] = above;
+        below[..lw * h as usize].par_chunks_mut(lw).enumerate().for_each(|(y, row)| {
+            for (x, t) in row.iter_mut().enumerate() {
+                *t = equirect::pyramid_texel(src, w, h, level, x as u32, y as u32);
+            }
+        });
+    }
+    pyramid
+}
+
 /// Level 0 of a cube of face size `size` (with room for its full mip chain) resampled from
 /// `env` with `supersample`² points per texel.
 pub fn equirect_to_cube(env: &Equirect, size: u32, supersample: u32) -> Cube {
     let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
     let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
+    let pyramid = equirect_pyramid(env);
+    let levels = equirect::pyramid_levels(env.width);
     let bar = progress("equirect", (FACES * size) as u64);
     let level0 = &mut texels[..(FACES * size * size) as usize];
     fill_level(level0, size, &bar, |face, x, y| {
-        equirect::cube_texel(&env.texels, env.width, env.height, face, x, y, size, supersample)
+        equirect::cube_texel(&pyramid, env.width, env.height, levels, face, x, y, size, supersample)
     });
     bar.finish_and_clear();
     Cube { layout, texels }

@@ -3,14 +3,17 @@
 //! images. Every problem is reported with the file it is in.
 //!
 //! Radiance must be finite and non-negative. Negative values (ringing of lossy EXR
-//! compressions such as DWAB) are set to 0 and counted. NaN and ±∞ are refused, with their
-//! count, unless sanitising is asked for; then NaN and −∞ become 0 and +∞ becomes the
-//! largest finite value of its channel in the image.
+//! compressions such as DWAB) are set to 0 and counted; values above
+//! `math::MAX_RADIANCE` (10²⁰, the headroom every sum of the bake is built for) are clamped
+//! to it and counted. NaN and ±∞ are refused, with their count, unless sanitising is asked
+//! for; then NaN and −∞ become 0 and +∞ becomes the largest finite value of its channel in
+//! the image (then clamped like any other).
 
 use crate::error::{Error, Result};
 use crate::texture::{Cube, Equirect};
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::glam::Vec4;
+use splitsum_shaders::math::MAX_RADIANCE;
 use std::path::{Path, PathBuf};
 
 /// Largest image side accepted (a 32768×16384 RGBA f32 equirect is 8 GiB).
@@ -32,6 +35,8 @@ pub enum Environment {
 pub struct InputReport {
     /// Texels with a negative channel, set to 0.
     pub negative: u64,
+    /// Texels with a channel above `MAX_RADIANCE`, clamped to it.
+    pub clamped: u64,
     /// Texels with a NaN channel.
     pub nan: u64,
     /// Texels with an infinite channel.
@@ -92,6 +97,7 @@ pub fn load_faces(paths: &[PathBuf; 6], sanitize: bool) -> Result<(Environment, 
         }
         let r = clean(p, &mut t, sanitize)?;
         report.negative += r.negative;
+        report.clamped += r.clamped;
         report.nan += r.nan;
         report.infinite += r.infinite;
         report.max_value = report.max_value.max(r.max_value);
@@ -226,6 +232,7 @@ pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputRe
     for t in texels.iter_mut() {
         let mut c = [t.x, t.y, t.z];
         let mut negative = false;
+        let mut clamped = false;
         for k in 0..3 {
             if c[k].is_nan() || c[k] == f32::NEG_INFINITY {
                 c[k] = 0.0;
@@ -235,8 +242,13 @@ pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputRe
                 c[k] = 0.0;
                 negative = true;
             }
+            if c[k] > MAX_RADIANCE {
+                c[k] = MAX_RADIANCE;
+                clamped = true;
+            }
         }
         report.negative += negative as u64;
+        report.clamped += clamped as u64;
         *t = Vec4::new(c[0], c[1], c[2], 1.0);
     }
     report.max_value = channel_max.iter().copied().fold(0.0, f32::max);

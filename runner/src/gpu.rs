@@ -18,6 +18,8 @@ pub static SPIRV: &[u8] = include_bytes!(env!("SPLITSUM_SPV"));
 pub enum Kernel {
     /// `kernels::brdf_lut`.
     BrdfLut,
+    /// `kernels::equirect_pyramid`.
+    EquirectPyramid,
     /// `kernels::equirect_to_cube`.
     EquirectToCube,
     /// `kernels::downsample`.
@@ -28,28 +30,34 @@ pub enum Kernel {
     IrradianceCube,
     /// `kernels::irradiance_sh9`.
     IrradianceSh9,
+    /// `kernels::probe`.
+    Probe,
 }
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 6] = [
+    pub const ALL: [Kernel; 8] = [
         Kernel::BrdfLut,
+        Kernel::EquirectPyramid,
         Kernel::EquirectToCube,
         Kernel::Downsample,
         Kernel::PrefilterSpecular,
         Kernel::IrradianceCube,
         Kernel::IrradianceSh9,
+        Kernel::Probe,
     ];
 
     /// The entry point's name in the SPIR-V module.
     pub fn entry_point(self) -> &'static str {
         match self {
             Kernel::BrdfLut => "kernels::brdf_lut",
+            Kernel::EquirectPyramid => "kernels::equirect_pyramid",
             Kernel::EquirectToCube => "kernels::equirect_to_cube",
             Kernel::Downsample => "kernels::downsample",
             Kernel::PrefilterSpecular => "kernels::prefilter_specular",
             Kernel::IrradianceCube => "kernels::irradiance_cube",
             Kernel::IrradianceSh9 => "kernels::irradiance_sh9",
+            Kernel::Probe => "kernels::probe",
         }
     }
 }

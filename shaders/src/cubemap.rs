@@ -29,7 +29,8 @@ use spirv_std::glam::{Vec2, Vec3, Vec4};
 /// Number of faces of a cube map.
 pub const FACES: u32 = 6;
 
-/// Size and mip count of a cube map stored level after level in a buffer.
+/// Size and mip count of a cube map stored level after level in a buffer. Face sizes are
+/// powers of two (the readers and the bake settings check it).
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub struct CubeLayout {
     /// Face size of level 0, in texels.
@@ -56,17 +57,22 @@ impl CubeLayout {
         if s == 0 { 1 } else { s }
     }
 
-    /// Index of the first texel of level `level`.
+    /// Index of the first texel of level `level`, in closed form for the power-of-two face
+    /// sizes every cube here has: `6·Σ_{k<L} (s/2ᵏ)² = 8(s² − (s/2ᴸ)²)` for `L ≤ log₂ s`,
+    /// then 6 more per 1×1 level. No loop: some drivers charge every loop entered, even an
+    /// empty one, against a shader's iteration budget (see `math::CHUNK`), and this runs
+    /// for every texel tap.
     #[inline]
     pub fn level_offset(&self, level: u32) -> u32 {
-        let mut offset = 0;
-        let mut i = 0;
-        while i < level {
-            let s = self.level_size(i);
-            offset += FACES * s * s;
-            i += 1;
+        let s = self.size;
+        // log₂ s from the f32 exponent (`leading_zeros` may be lowered to a loop).
+        let p = ((s as f32).to_bits() >> 23) - 127; // level p is 1×1
+        if level <= p {
+            let t = s >> level;
+            8 * (s * s - t * t)
+        } else {
+            8 * s * s - 2 + FACES * (level - p - 1)
         }
-        offset
     }
 
     /// Number of texels in all levels.
@@ -190,6 +196,20 @@ fn tap_index(layout: CubeLayout, level: u32, face: u32, x: i32, y: i32, s: u32) 
     }
 }
 
+/// One weighted bilinear tap: the texel's value times `w`, and `w`; nothing for a tap off
+/// the face in both axes.
+#[inline]
+fn tap(texels: &[Vec4], layout: CubeLayout, level: u32, face: u32, s: u32, x: i32, y: i32, w: f32) -> (Vec4, f32) {
+    let si = s as i32;
+    let x_in = x >= 0 && x < si;
+    let y_in = y >= 0 && y < si;
+    if x_in || y_in {
+        (texels[tap_index(layout, level, face, x, y, s) as usize] * w, w)
+    } else {
+        (Vec4::ZERO, 0.0)
+    }
+}
+
 /// Seamless bilinear lookup of level `level` in direction `d` (need not be unit length).
 pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3) -> Vec4 {
     let s = layout.level_size(level);
@@ -203,28 +223,15 @@ pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3)
     let ty = fy - y0f;
     let x0 = x0f as i32;
     let y0 = y0f as i32;
-    let si = s as i32;
-    let mut acc = Vec4::ZERO;
-    let mut wsum = 0.0;
-    // The four taps; one that is off the face in both axes (a cube corner) is dropped.
-    let mut k = 0;
-    while k < 4 {
-        let dx = (k & 1) as i32;
-        let dy = (k >> 1) as i32;
-        let x = x0 + dx;
-        let y = y0 + dy;
-        let wx = if dx == 0 { 1.0 - tx } else { tx };
-        let wy = if dy == 0 { 1.0 - ty } else { ty };
-        let w = wx * wy;
-        let x_in = x >= 0 && x < si;
-        let y_in = y >= 0 && y < si;
-        if x_in || y_in {
-            acc += texels[tap_index(layout, level, face, x, y, s) as usize] * w;
-            wsum += w;
-        }
-        k += 1;
-    }
-    acc * (1.0 / wsum)
+    // The four taps, unrolled; one that is off the face in both axes (a cube corner) is
+    // dropped, weight and all.
+    let (a, wa) = tap(texels, layout, level, face, s, x0, y0, (1.0 - tx) * (1.0 - ty));
+    let (b, wb) = tap(texels, layout, level, face, s, x0 + 1, y0, tx * (1.0 - ty));
+    let (c, wc) = tap(texels, layout, level, face, s, x0, y0 + 1, (1.0 - tx) * ty);
+    let (e, we) = tap(texels, layout, level, face, s, x0 + 1, y0 + 1, tx * ty);
+    let acc = a + b + c + e;
+    let wsum = wa + wb + wc + we;
+    math::finite4(acc * (1.0 / wsum))
 }
 
 /// Seamless trilinear lookup at fractional level `lod`, clamped to the stored levels.
@@ -237,7 +244,7 @@ pub fn sample_lod(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) -> Vec
     let a = sample_bilinear(texels, layout, m0, d);
     if t > 0.0 && m0 + 1 < layout.levels {
         let b = sample_bilinear(texels, layout, m0 + 1, d);
-        a * (1.0 - t) + b * t
+        math::finite4(a * (1.0 - t) + b * t)
     } else {
         a
     }
@@ -250,16 +257,23 @@ pub fn downsample_texel(texels: &[Vec4], layout: CubeLayout, level: u32, face: u
     if s == 1 {
         return texels[layout.index(level, face, 0, 0) as usize];
     }
-    let mut acc = Vec4::ZERO;
+    // Normalised weights first, so that the sum never exceeds the largest input (no
+    // overflow even at f32::MAX).
+    let mut w = [0.0f32; 4];
     let mut wsum = 0.0;
     let mut k = 0;
     while k < 4 {
-        let cx = 2 * x + (k & 1);
-        let cy = 2 * y + (k >> 1);
-        let w = texel_solid_angle(cx, cy, s);
-        acc += texels[layout.index(level, face, cx, cy) as usize] * w;
-        wsum += w;
+        w[k] = texel_solid_angle(2 * x + (k as u32 & 1), 2 * y + (k as u32 >> 1), s);
+        wsum += w[k];
         k += 1;
     }
-    acc * (1.0 / wsum)
+    let mut acc = Vec4::ZERO;
+    k = 0;
+    while k < 4 {
+        let cx = 2 * x + (k as u32 & 1);
+        let cy = 2 * y + (k as u32 >> 1);
+        acc += texels[layout.index(level, face, cx, cy) as usize] * (w[k] / wsum);
+        k += 1;
+    }
+    math::finite4(acc)
 }

@@ -6,12 +6,18 @@
 //!
 //! **Area-correct resampling**: a cube texel is the solid-angle-weighted mean of the
 //! environment over the texel: `L = Σ L(ωⱼ) J(ωⱼ) / Σ J(ωⱼ)` over an `n×n` grid of points in
-//! the texel, with the cube-face Jacobian `J = (1 + a² + b²)^(−3/2)` and a bilinear
-//! reconstruction of the environment. The host picks `n` so that the points are at least
-//! as dense as the source texels (see [`supersampling`]); a small bright source therefore
-//! lands in the cube with its power, whatever its position, instead of aliasing to
-//! whichever texel a single point sample hits. The weights are normalised, so a constant
-//! environment gives exactly that constant.
+//! the texel, with the cube-face Jacobian `J = (1 + a² + b²)^(−3/2)`. Each point reads the
+//! mean of the environment over its own footprint in longitude (which near a pole spans
+//! `1/sin θ` times more texels) and interpolates linearly between rows. The host picks `n`
+//! so that the points are at least as dense as the source texels (see [`supersampling`]);
+//! a small bright source therefore lands in the cube with its power, whatever its
+//! position, instead of aliasing to whichever texel a single point sample hits. The
+//! weights are normalised, so a constant environment gives exactly that constant.
+//!
+//! **Row pyramid**: footprints are averaged from a pyramid that halves each row while its
+//! width stays even (level k texel = mean of 2ᵏ source texels), at the level where the
+//! footprint spans at most 16 texels — a bounded loop, whatever the footprint (a driver may
+//! bound a shader's loop iterations, see `math::CHUNK`).
 
 use crate::cubemap;
 use crate::math;
@@ -33,15 +39,45 @@ pub fn uv_to_dir(uv: Vec2) -> Vec3 {
     Vec3::new(sin_theta * sin_phi, cos_theta, -sin_theta * cos_phi)
 }
 
-/// The mean of row `y` over the interval `[a, a + len)` in texel units (wrapping around in
-/// `u`), `1 ≤ len ≤ width`, of the piecewise-constant image: each texel weighs in by its
-/// overlap with the interval.
-fn row_mean(texels: &[Vec4], width: u32, y: u32, a: f32, len: f32) -> Vec4 {
+/// Levels of the row pyramid of a `width`-wide image: each halves the one above while the
+/// width is even (1024 → 11 levels, down to 1).
+pub fn pyramid_levels(width: u32) -> u32 {
+    // The number of trailing zero bits, plus the image itself.
+    let tz = width.trailing_zeros();
+    let tz = if tz > 15 { 15 } else { tz };
+    tz + 1
+}
+
+/// Index of the first texel of pyramid level `level` (all levels `height` rows high):
+/// `height·Σ_{k<L} width/2ᵏ = height·(2·width − 2·(width ≫ L))`.
+#[inline]
+pub fn pyramid_offset(level: u32, width: u32, height: u32) -> u32 {
+    height * (2 * width - 2 * (width >> level))
+}
+
+/// Number of texels in all levels of the pyramid.
+#[inline]
+pub fn pyramid_len(width: u32, height: u32) -> u32 {
+    let last = pyramid_levels(width) - 1;
+    pyramid_offset(last, width, height) + height * (width >> last)
+}
+
+/// Texel `(x, y)` of pyramid level `level ≥ 1`: the mean of the two texels below it.
+#[inline]
+pub fn pyramid_texel(pyramid: &[Vec4], width: u32, height: u32, level: u32, x: u32, y: u32) -> Vec4 {
+    let w = width >> (level - 1);
+    let base = pyramid_offset(level - 1, width, height) + y * w + 2 * x;
+    pyramid[base as usize] * 0.5 + pyramid[(base + 1) as usize] * 0.5
+}
+
+/// The mean of row `y` of pyramid level `level` over `[a, a + len)` in that level's texel
+/// units (wrapping in `u`), `1 ≤ len ≤ width`: each texel weighs in by its overlap.
+fn row_mean(pyramid: &[Vec4], width: u32, height: u32, level: u32, y: u32, a: f32, len: f32) -> Vec4 {
     let end = a + len;
     let k0 = math::floor(a) as i32;
     let k1 = math::floor(end) as i32;
-    let w = width as i32;
-    let row = y * width;
+    let w = (width >> level) as i32;
+    let row = pyramid_offset(level, width, height) + y * w as u32;
     let mut acc = Vec4::ZERO;
     let mut k = k0;
     while k <= k1 {
@@ -52,49 +88,57 @@ fn row_mean(texels: &[Vec4], width: u32, y: u32, a: f32, len: f32) -> Vec4 {
             if x < 0 {
                 x += w;
             }
-            acc += texels[(row + x as u32) as usize] * (hi - lo);
+            // Weights normalised as they go: the mean never exceeds the largest texel.
+            acc += pyramid[(row + x as u32) as usize] * ((hi - lo) / len);
         }
         k += 1;
     }
-    acc * (1.0 / len)
+    math::finite4(acc)
 }
 
-/// Area lookup in a `width`×`height` RGBA image at `(u, v)`: the mean over a window
-/// `window` texels wide in `u` (at least one texel, at most the whole row; wrapping),
-/// interpolated linearly between rows in `v` (clamped). A one-texel window is exactly
-/// bilinear interpolation; wider windows integrate every texel they cover, which is what
-/// keeps narrow features near the poles — where texels shrink in `u` — from being missed.
-pub fn sample_area(texels: &[Vec4], width: u32, height: u32, uv: Vec2, window: f32) -> Vec4 {
-    let w = width as f32;
+/// Area lookup at `(u, v)` in the row pyramid of a `width`×`height` image: the mean over a
+/// window `window` level-0 texels wide in `u` (at least one texel, at most the whole row;
+/// wrapping), interpolated linearly between rows in `v` (clamped). A one-texel window is
+/// exactly bilinear interpolation; wider windows integrate every texel they cover, which
+/// is what keeps narrow features near the poles — where texels shrink in `u` — from being
+/// missed. Windows wider than 16 texels are read from the pyramid level where they span
+/// 8 to 16 texels.
+pub fn sample_area(pyramid: &[Vec4], width: u32, height: u32, levels: u32, uv: Vec2, window: f32) -> Vec4 {
     let fy = math::clamp(uv.y * height as f32 - 0.5, 0.0, (height - 1) as f32);
     let y0f = math::floor(fy);
     let ty = fy - y0f;
     let y0 = y0f as u32;
     let y1 = if y0 + 1 < height { y0 + 1 } else { y0 };
-    let len = math::clamp(window, 1.0, w);
+    let win = math::clamp(window, 1.0, width as f32);
+    let level = if win > 16.0 { math::min(math::floor(math::log2(win * 0.0625)) + 1.0, (levels - 1) as f32) as u32 } else { 0 };
+    let scale = 1.0 / (1u32 << level) as f32;
+    let w = (width >> level) as f32;
+    let len = math::clamp(win * scale, 1.0, w);
     let a = uv.x * w - 0.5 * len;
-    let r0 = row_mean(texels, width, y0, a, len);
-    let r1 = row_mean(texels, width, y1, a, len);
-    r0 * (1.0 - ty) + r1 * ty
+    let r0 = row_mean(pyramid, width, height, level, y0, a, len);
+    let r1 = row_mean(pyramid, width, height, level, y1, a, len);
+    math::finite4(r0 * (1.0 - ty) + r1 * ty)
 }
 
 /// Points per axis, per cube texel, so that the supersampling grid is `density` times as
 /// fine as the equirect's texels at the equator (where they are largest), clamped to
-/// [1, 32]. A cube texel at the face centre spans `2/size` radians; an equirect texel spans
-/// `2π/width`.
+/// [1, 16] (a cube smaller than its source by more than that is better made from the
+/// source's mip chain). A cube texel at the face centre spans `2/size` radians; an
+/// equirect texel spans `2π/width`.
 pub fn supersampling(face_size: u32, width: u32, density: f32) -> u32 {
     let cube_texel = 2.0 / face_size as f32;
     let src_texel = math::TAU / width as f32;
     let n = math::floor(density * cube_texel / src_texel + 0.999);
-    math::clamp(n, 1.0, 32.0) as u32
+    math::clamp(n, 1.0, 16.0) as u32
 }
 
-/// Cube texel `(x, y)` of `face` (face size `size`) resampled from the equirect image with
-/// an `n×n` grid of solid-angle-weighted samples, each the mean over its own footprint in
-/// `u` ([`sample_area`]): the grid spacing, `2/(size·n)` on the face plane, is about
-/// `2/(size·n·|p|)` radians at point `p`, which near a pole spans `1/sin θ` times more
-/// longitude.
-pub fn cube_texel(texels: &[Vec4], width: u32, height: u32, face: u32, x: u32, y: u32, size: u32, n: u32) -> Vec4 {
+/// Cube texel `(x, y)` of `face` (face size `size`) resampled from the equirect image's row
+/// pyramid (`levels` levels) with an `n×n` grid of solid-angle-weighted samples, each the
+/// mean over its own footprint in `u` ([`sample_area`]): the grid spacing, `2/(size·n)` on
+/// the face plane, is about `2/(size·n·|p|)` radians at point `p`, which near a pole spans
+/// `1/sin θ` times more longitude.
+#[allow(clippy::too_many_arguments)]
+pub fn cube_texel(pyramid: &[Vec4], width: u32, height: u32, levels: u32, face: u32, x: u32, y: u32, size: u32, n: u32) -> Vec4 {
     let s = size as f32;
     let nf = n as f32;
     let spacing = 2.0 / (s * nf);
@@ -112,15 +156,17 @@ pub fn cube_texel(texels: &[Vec4], width: u32, height: u32, face: u32, x: u32, y
             let p = cubemap::face_uv_to_cube(face, uv);
             let r2 = p.dot(p);
             let r = math::sqrt(r2);
-            let w = 1.0 / (r2 * r); // (1 + a² + b²)^(−3/2)
+            // (1 + a² + b²)^(−3/2) ≤ 1, divided by n² so the weights sum to at most 1 and
+            // the weighted sum cannot overflow.
+            let w = 1.0 / (r2 * r) / (nf * nf);
             // Longitude spanned by one grid step: (spacing/r) / sin θ, sin θ = √(x²+z²)/r.
             let rho = math::sqrt(p.x * p.x + p.z * p.z);
             let window = if rho > 0.0 { spacing / rho * texels_per_radian } else { width as f32 };
-            acc += sample_area(texels, width, height, dir_to_uv(p), window) * w;
+            acc += sample_area(pyramid, width, height, levels, dir_to_uv(p), window) * w;
             wsum += w;
             i += 1;
         }
         j += 1;
     }
-    acc * (1.0 / wsum)
+    math::finite4(acc * (1.0 / wsum))
 }

@@ -16,7 +16,7 @@
 //! `E(n)/π = Σ (Âₗ/π) L_lm Y_lm(n)` with `Âₗ/π = 1, 2/3, 1/4` for `l = 0, 1, 2`.
 
 use crate::cubemap::{self, CubeLayout};
-use crate::math::{CompensatedSum, CompensatedSum4};
+use crate::math::{self, CompensatedSum, CompensatedSum4, MeanPartial};
 use spirv_std::glam::{Vec3, Vec4};
 
 /// Number of SH coefficients up to band 2.
@@ -56,31 +56,48 @@ pub fn sh9_irradiance(coeffs: &[Vec4; SH9], n: Vec3) -> Vec3 {
     e
 }
 
-/// `E(n)/π` at unit normal `n` by the exact cosine-weighted sum over every texel of
-/// `level` of the source cube.
+/// `E(n)/π` at normal `n` by the exact cosine-weighted sum over every texel of `level` of
+/// the source cube: [`accumulate`] over chunks of `math::CHUNK` texels, then the mean.
 pub fn convolve_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3) -> Vec4 {
     let s = layout.level_size(level);
-    let mut acc = CompensatedSum4::new();
-    let mut wsum = CompensatedSum::new();
-    let mut face = 0;
-    while face < cubemap::FACES {
-        let mut y = 0;
-        while y < s {
-            let mut x = 0;
-            while x < s {
-                let c = n.dot(cubemap::texel_dir(face, x, y, s));
-                if c > 0.0 {
-                    let w = c * cubemap::texel_solid_angle(x, y, s);
-                    acc.add(src[layout.index(level, face, x, y) as usize] * w);
-                    wsum.add(w);
-                }
-                x += 1;
-            }
-            y += 1;
-        }
-        face += 1;
+    let total = cubemap::FACES * s * s;
+    let mut p = MeanPartial::default();
+    let mut start = 0u32;
+    while start < total {
+        let c = if total - start < math::CHUNK { total - start } else { math::CHUNK };
+        p = accumulate(src, layout, level, n, start, c, p);
+        start += c;
     }
-    acc.total() * (1.0 / wsum.total())
+    p.resolve()
+}
+
+/// Adds texels `start .. start + count` of `level` (numbered face by face, row by row) to
+/// the cosine-weighted mean for normal `n`.
+pub fn accumulate(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
+    // A zero or non-finite normal is read as +z: never an empty hemisphere, never NaN.
+    let n = crate::sampling::normalize_or(n, Vec3::Z);
+    let s = layout.level_size(level);
+    let base = layout.level_offset(level);
+    let mut acc = CompensatedSum4::resume(p.sum, p.carry);
+    let mut wsum = CompensatedSum::resume(p.weight.x, p.weight.y);
+    let mut t = start;
+    let end = start + count;
+    while t < end {
+        let face = t / (s * s);
+        let y = (t / s) % s;
+        let x = t % s;
+        let c = n.dot(cubemap::texel_dir(face, x, y, s));
+        if c > 0.0 {
+            // Scaled by 1/(4π) so the weights sum to about 1/4: no overflow.
+            let w = c * cubemap::texel_solid_angle(x, y, s) * (0.25 * math::FRAC_1_PI);
+            acc.add(src[(base + t) as usize] * w);
+            wsum.add(w);
+        }
+        t += 1;
+    }
+    let (sum, carry) = acc.parts();
+    let (w, wc) = wsum.parts();
+    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
 }
 
 /// The contribution of row `y` of `face` of `level` to the SH projection: nine RGB

@@ -4,11 +4,16 @@
 //! Binding scheme, the same for every kernel: set 0, binding 0 the parameters (uniform),
 //! binding 1 the input texels (read-only storage), binding 2 the output (storage).
 //! Texel kernels run 8×8 invocations per workgroup with `z` the cube face.
+//!
+//! Long sums (BRDF table, prefilter, irradiance) run one chunk of at most `math::CHUNK`
+//! terms per dispatch, carrying compensated partial sums in the output buffer; the host
+//! resolves them with the same functions the CPU backend uses.
 
 use crate::cubemap::{self, CubeLayout};
+use crate::math::MeanPartial;
 use crate::{equirect, irradiance, lut, prefilter};
 use bytemuck::{Pod, Zeroable};
-use spirv_std::glam::{UVec3, Vec2, Vec4};
+use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
 
 /// Workgroup width and height of the texel kernels.
@@ -20,28 +25,40 @@ pub const TILE: u32 = 8;
 pub struct LutParams {
     /// Table width and height.
     pub size: u32,
-    /// Hammersley points per texel.
+    /// Hammersley points per texel, in all.
     pub samples: u32,
     /// First row of this dispatch.
     pub row_offset: u32,
-    /// Unused; keeps the block 16 bytes.
-    pub pad: u32,
+    /// First sample of this dispatch's chunk.
+    pub start: u32,
+    /// Samples in this chunk (at most `math::CHUNK`).
+    pub count: u32,
+    /// Unused; keeps the block a multiple of 16 bytes.
+    pub pad0: u32,
+    /// Unused.
+    pub pad1: u32,
+    /// Unused.
+    pub pad2: u32,
 }
 
-/// One texel of the split-sum BRDF table: `out[y·size + x] = (scale, bias)`.
+/// One chunk of one texel of the split-sum BRDF table: adds samples `start..start+count`
+/// to the compensated partial sums `accum[y·size + x]` (`lut::accumulate`); the host
+/// resolves the sums with `lut::resolve` once every chunk has run.
 #[spirv(compute(threads(8, 8)))]
 pub fn brdf_lut(
     #[spirv(global_invocation_id)] id: UVec3,
     #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &LutParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec2],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
 ) {
     let y = id.y + p.row_offset;
     if id.x < p.size && y < p.size {
-        out[(y * p.size + id.x) as usize] = lut::texel(id.x, y, p.size, p.samples);
+        let i = (y * p.size + id.x) as usize;
+        let c = lut::texel_coords(id.x, y, p.size);
+        accum[i] = lut::accumulate(c.x, c.y, p.samples, p.start, p.count, accum[i]);
     }
 }
 
-/// Parameters of [`equirect_to_cube`].
+/// Parameters of [`equirect_pyramid`] and [`equirect_to_cube`].
 #[derive(Copy, Clone, Debug, Pod, Zeroable)]
 #[repr(C)]
 pub struct EquirectParams {
@@ -53,19 +70,42 @@ pub struct EquirectParams {
     pub face_size: u32,
     /// Supersampling points per axis per cube texel.
     pub supersample: u32,
+    /// Levels of the row pyramid.
+    pub levels: u32,
+    /// The pyramid level written (by [`equirect_pyramid`]).
+    pub level: u32,
+    /// Unused; keeps the block a multiple of 16 bytes.
+    pub pad0: u32,
+    /// Unused.
+    pub pad1: u32,
 }
 
-/// One texel of level 0 of the source cube, resampled from the equirect image.
+/// One texel of level `level` of the equirect's row pyramid, from level `level − 1` of the
+/// same buffer.
+#[spirv(compute(threads(8, 8)))]
+pub fn equirect_pyramid(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &EquirectParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] pyramid: &mut [Vec4],
+) {
+    let w = p.width >> p.level;
+    if id.x < w && id.y < p.height {
+        let v = equirect::pyramid_texel(pyramid, p.width, p.height, p.level, id.x, id.y);
+        pyramid[(equirect::pyramid_offset(p.level, p.width, p.height) + id.y * w + id.x) as usize] = v;
+    }
+}
+
+/// One texel of level 0 of the source cube, resampled from the equirect's row pyramid.
 #[spirv(compute(threads(8, 8)))]
 pub fn equirect_to_cube(
     #[spirv(global_invocation_id)] id: UVec3,
     #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &EquirectParams,
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] pyramid: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
 ) {
     let s = p.face_size;
     if id.x < s && id.y < s && id.z < cubemap::FACES {
-        let v = equirect::cube_texel(src, p.width, p.height, id.z, id.x, id.y, s, p.supersample);
+        let v = equirect::cube_texel(pyramid, p.width, p.height, p.levels, id.z, id.x, id.y, s, p.supersample);
         out[((id.z * s + id.y) * s + id.x) as usize] = v;
     }
 }
@@ -109,31 +149,58 @@ pub struct PrefilterParams {
     pub src_levels: u32,
     /// Face size of the level written.
     pub dst_size: u32,
-    /// GGX samples per texel.
+    /// GGX samples per texel, in all.
     pub samples: u32,
     /// Perceptual roughness of the level written.
     pub roughness: f32,
     /// Bias added to the source level of each sample.
     pub lod_bias: f32,
-    /// Index in the output of the first texel of the level written.
+    /// Index in the output layout of the first texel of the level written.
     pub dst_offset: u32,
+    /// First sample of this dispatch's chunk.
+    pub start: u32,
+    /// Samples in this chunk (at most `math::CHUNK`).
+    pub count: u32,
     /// Unused; keeps the block a multiple of 16 bytes.
-    pub pad: u32,
+    pub pad0: u32,
+    /// Unused.
+    pub pad1: u32,
+    /// Unused.
+    pub pad2: u32,
 }
 
-/// One texel of one level of the prefiltered specular cube.
+/// Reads the three `Vec4` of a [`MeanPartial`] at `accum[3i..]`.
+#[inline]
+fn load_partial(accum: &[Vec4], i: usize) -> MeanPartial {
+    MeanPartial { sum: accum[3 * i], carry: accum[3 * i + 1], weight: accum[3 * i + 2] }
+}
+
+/// Writes a [`MeanPartial`] at `accum[3i..]`.
+#[inline]
+fn store_partial(accum: &mut [Vec4], i: usize, p: MeanPartial) {
+    accum[3 * i] = p.sum;
+    accum[3 * i + 1] = p.carry;
+    accum[3 * i + 2] = p.weight;
+}
+
+/// One chunk of samples of one texel of one level of the prefiltered specular cube: adds
+/// them to the texel's partial sums in `accum` (three `Vec4` per texel); the host resolves
+/// the means once every chunk has run (`prefilter::accumulate`, `MeanPartial::resolve`).
 #[spirv(compute(threads(8, 8)))]
 pub fn prefilter_specular(
     #[spirv(global_invocation_id)] id: UVec3,
     #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &PrefilterParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
 ) {
     let s = p.dst_size;
     if id.x < s && id.y < s && id.z < cubemap::FACES {
         let layout = CubeLayout::new(p.src_size, p.src_levels);
-        let v = prefilter::prefilter_texel(src, layout, id.z, id.x, id.y, s, p.roughness, p.samples, p.lod_bias);
-        out[(p.dst_offset + (id.z * s + id.y) * s + id.x) as usize] = v;
+        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
+        let n = cubemap::texel_dir(id.z, id.x, id.y, s);
+        let partial = load_partial(accum, i);
+        let next = prefilter::accumulate(src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial);
+        store_partial(accum, i, next);
     }
 }
 
@@ -149,21 +216,32 @@ pub struct IrradianceParams {
     pub src_level: u32,
     /// Face size of the irradiance cube written.
     pub dst_size: u32,
+    /// First source texel of this dispatch's chunk.
+    pub start: u32,
+    /// Source texels in this chunk (at most `math::CHUNK`).
+    pub count: u32,
+    /// Unused; keeps the block a multiple of 16 bytes.
+    pub pad0: u32,
+    /// Unused.
+    pub pad1: u32,
 }
 
-/// One texel of the irradiance cube (`E/π`).
+/// One chunk of source texels for one texel of the irradiance cube: adds them to its
+/// partial sums in `accum` (three `Vec4` per texel; `irradiance::accumulate`).
 #[spirv(compute(threads(8, 8)))]
 pub fn irradiance_cube(
     #[spirv(global_invocation_id)] id: UVec3,
     #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &IrradianceParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
-    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
 ) {
     let s = p.dst_size;
     if id.x < s && id.y < s && id.z < cubemap::FACES {
         let layout = CubeLayout::new(p.src_size, p.src_levels);
+        let i = ((id.z * s + id.y) * s + id.x) as usize;
         let n = cubemap::texel_dir(id.z, id.x, id.y, s);
-        out[((id.z * s + id.y) * s + id.x) as usize] = irradiance::convolve_dir(src, layout, p.src_level, n);
+        let partial = load_partial(accum, i);
+        store_partial(accum, i, irradiance::accumulate(src, layout, p.src_level, n, p.start, p.count, partial));
     }
 }
 
@@ -186,5 +264,79 @@ pub fn irradiance_sh9(
             out[base + k] = row[k];
             k += 1;
         }
+    }
+}
+
+/// What [`probe`] evaluates.
+pub mod probe_mode {
+    /// `lut::accumulate(n·v = q.x, roughness = q.y)`: the partial sums in `out[3i]`.
+    pub const LUT: u32 = 0;
+    /// `prefilter::accumulate(dir = q.xyz, roughness = q.w)`: a `MeanPartial` in `out[3i..]`.
+    pub const PREFILTER: u32 = 1;
+    /// `irradiance::accumulate(normal = q.xyz)` over level `src_level`: a `MeanPartial`.
+    pub const IRRADIANCE: u32 = 2;
+    /// `cubemap::sample_lod(dir = q.xyz, lod = q.w)` in `out[3i]`.
+    pub const SAMPLE: u32 = 3;
+}
+
+/// Parameters of [`probe`].
+#[derive(Copy, Clone, Debug, Pod, Zeroable)]
+#[repr(C)]
+pub struct ProbeParams {
+    /// A [`probe_mode`] constant.
+    pub mode: u32,
+    /// Number of probes.
+    pub count: u32,
+    /// Index in the input of the first probe (the cube's texels come first).
+    pub probe_offset: u32,
+    /// Samples in all (LUT, prefilter).
+    pub samples: u32,
+    /// Level-0 face size of the cube.
+    pub src_size: u32,
+    /// Levels of the cube.
+    pub src_levels: u32,
+    /// Level summed over (irradiance).
+    pub src_level: u32,
+    /// Source-level bias (prefilter).
+    pub lod_bias: f32,
+    /// First sample (or source texel) of this chunk.
+    pub start: u32,
+    /// Samples (or texels) in this chunk.
+    pub chunk: u32,
+    /// Unused; keeps the block a multiple of 16 bytes.
+    pub pad0: u32,
+    /// Unused.
+    pub pad1: u32,
+}
+
+/// One chunk of probe `q`: the math at an arbitrary input, so that tests run the same
+/// inputs (poles, corners, zero vectors, extreme values) natively and on the GPU. Writes
+/// (or continues) three `Vec4` at `out[3i..]`.
+pub fn probe_chunk(p: &ProbeParams, input: &[Vec4], q: Vec4, out: &mut [Vec4], i: usize) {
+    let layout = CubeLayout::new(p.src_size, p.src_levels);
+    if p.mode == probe_mode::LUT {
+        out[3 * i] = lut::accumulate(q.x, q.y, p.samples, p.start, p.chunk, out[3 * i]);
+    } else if p.mode == probe_mode::PREFILTER {
+        let partial = load_partial(out, i);
+        store_partial(out, i, prefilter::accumulate(input, layout, q.truncate(), q.w, p.samples, p.start, p.chunk, p.lod_bias, partial));
+    } else if p.mode == probe_mode::IRRADIANCE {
+        let partial = load_partial(out, i);
+        store_partial(out, i, irradiance::accumulate(input, layout, p.src_level, q.truncate(), p.start, p.chunk, partial));
+    } else {
+        out[3 * i] = cubemap::sample_lod(input, layout, q.truncate(), q.w);
+    }
+}
+
+/// Evaluates one chunk of probe `id.x` (see [`probe_chunk`]).
+#[spirv(compute(threads(64)))]
+pub fn probe(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &ProbeParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] input: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+) {
+    if id.x < p.count {
+        let q = input[(p.probe_offset + id.x) as usize];
+        probe_chunk(p, input, q, out, id.x as usize);
     }
 }

@@ -18,7 +18,7 @@
 use crate::brdf::{alpha_from_roughness, fresnel, microfacet};
 use crate::math::{self, CompensatedSum};
 use crate::sampling;
-use spirv_std::glam::{Vec2, Vec3};
+use spirv_std::glam::{Vec2, Vec3, Vec4};
 
 /// Smallest `n·v` the table is evaluated at. At `n·v = 0` the view direction lies in the
 /// surface plane: its mirror direction grazes the surface (`n·l = 0`) and the reflected
@@ -29,8 +29,23 @@ pub const MIN_N_DOT_V: f32 = 1e-4;
 
 /// Split-sum `(scale, bias)` for `n·v` and perceptual `roughness`, from `samples`
 /// Hammersley points. `scale + bias ≤ 1`: the sum is the directional albedo of the
-/// specular lobe with `F₀ = 1`.
+/// specular lobe with `F₀ = 1`. Runs as [`accumulate`] over chunks of `math::CHUNK`
+/// samples, then [`resolve`] — the same arithmetic the GPU runs one chunk per dispatch.
 pub fn integrate_brdf(n_dot_v: f32, roughness: f32, samples: u32) -> Vec2 {
+    let n = samples.max(1);
+    let mut state = Vec4::ZERO;
+    let mut start = 0u32;
+    while start < n {
+        let count = if n - start < math::CHUNK { n - start } else { math::CHUNK };
+        state = accumulate(n_dot_v, roughness, n, start, count, state);
+        start += count;
+    }
+    resolve(state, n)
+}
+
+/// Adds samples `start .. start + count` (of `samples` in all) of the table's integrand at
+/// `(n·v, roughness)` to `state`, the compensated partial sums `(A, carry, B, carry)`.
+pub fn accumulate(n_dot_v: f32, roughness: f32, samples: u32, start: u32, count: u32, state: Vec4) -> Vec4 {
     let nv = math::clamp(n_dot_v, MIN_N_DOT_V, 1.0);
     let r = math::saturate(roughness);
     let alpha = alpha_from_roughness(r);
@@ -38,10 +53,11 @@ pub fn integrate_brdf(n_dot_v: f32, roughness: f32, samples: u32) -> Vec2 {
     // View vector in tangent space, normal = +z.
     let v = Vec3::new(math::sqrt((1.0 - nv) * (1.0 + nv)), 0.0, nv);
     let n = samples.max(1);
-    let mut a = CompensatedSum::new();
-    let mut b = CompensatedSum::new();
-    let mut i = 0u32;
-    while i < n {
+    let mut a = CompensatedSum::resume(state.x, state.y);
+    let mut b = CompensatedSum::resume(state.z, state.w);
+    let mut i = start;
+    let end = start + count;
+    while i < end {
         let h = sampling::sample_ggx_tangent(sampling::hammersley(i, n), alpha);
         let v_dot_h = v.dot(h);
         let l = h * (2.0 * v_dot_h) - v;
@@ -56,8 +72,21 @@ pub fn integrate_brdf(n_dot_v: f32, roughness: f32, samples: u32) -> Vec2 {
         }
         i += 1;
     }
-    let inv = 1.0 / n as f32;
-    Vec2::new(a.total() * inv, b.total() * inv)
+    let (sa, ca) = a.parts();
+    let (sb, cb) = b.parts();
+    Vec4::new(sa, ca, sb, cb)
+}
+
+/// The table value from the partial sums of all `samples`.
+pub fn resolve(state: Vec4, samples: u32) -> Vec2 {
+    let inv = 1.0 / samples.max(1) as f32;
+    let (a, b) = (state.x * inv, state.z * inv);
+    // The integral is a directional albedo, at most 1 (exactly 1 for a mirror). Rounding of
+    // the sums — GPU compilers may drop the summation's compensation — can push the
+    // estimate a few 10⁻⁶ past that bound; project it back so a renderer never gains
+    // energy from the table.
+    let s = a + b;
+    if s > 1.0 { Vec2::new(a / s, b / s) } else { Vec2::new(a, b) }
 }
 
 /// The coordinates `(n·v, roughness)` of texel `(x, y)` in an `size`×`size` table.

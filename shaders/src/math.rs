@@ -20,6 +20,12 @@
 use spirv_std::glam::Vec4;
 use spirv_std::num_traits::Float;
 
+/// Largest radiance the bake takes in; larger input values are clamped to it when an
+/// environment is read (and counted). Every sum in the pipeline has at most 2³² terms of
+/// weight ≤ 1 and products with BRDF peaks stay below 10¹⁵ (GGX at the minimum direct
+/// roughness times a sun), so with inputs ≤ 10²⁰ nothing reaches f32::MAX ≈ 3.4·10³⁸.
+pub const MAX_RADIANCE: f32 = 1e20;
+
 /// π in f32.
 pub const PI: f32 = core::f32::consts::PI;
 /// 1/π in f32.
@@ -222,12 +228,40 @@ pub fn saturate(x: f32) -> f32 {
     clamp(x, 0.0, 1.0)
 }
 
-/// Kahan's compensated summation: the sum of 2²⁴ and more f32 terms without the O(N·ε)
-/// drift of naive accumulation (Kahan 1965, "Further remarks on reducing truncation
-/// errors"; Higham, *Accuracy and Stability of Numerical Algorithms* §4.3). Branch-free,
-/// so it costs the GPU no divergence.
+/// `v` with every channel above `f32::MAX` (an infinity born of rounding in a weighted mean
+/// of values near `f32::MAX`) brought back to `f32::MAX`. A weighted mean of finite inputs
+/// is mathematically at most their maximum; this keeps it finite when rounding says
+/// otherwise.
+#[inline]
+pub fn finite4(v: Vec4) -> Vec4 {
+    let c = |x: f32| if x > f32::MAX { f32::MAX } else { x };
+    Vec4::new(c(v.x), c(v.y), c(v.z), c(v.w))
+}
+
+/// Terms per block of [`CompensatedSum`].
+pub const SUM_BLOCK: u32 = 1024;
+
+/// One step of Kahan's compensated addition of `x` into `(sum, carry)`.
+macro_rules! kahan {
+    ($sum:expr, $carry:expr, $x:expr) => {{
+        let y = $x - $carry;
+        let t = $sum + y;
+        $carry = (t - $sum) - y;
+        $sum = t;
+    }};
+}
+
+/// Summation of 2²⁴ and more f32 terms without the O(N·ε) drift of naive accumulation:
+/// Kahan-compensated sums of blocks of [`SUM_BLOCK`] terms, themselves added with Kahan's
+/// compensation (Kahan 1965; Higham, *Accuracy and Stability of Numerical Algorithms*
+/// §4.3–4.4). The blocks matter where a GPU compiler reassociates the compensation away
+/// (Mesa's lavapipe does): what is left is then a blocked sum with error O((B + N/B)·ε)
+/// instead of O(N·ε). Branch-light, no arrays: cheap in registers.
 #[derive(Copy, Clone, Default)]
 pub struct CompensatedSum {
+    block: f32,
+    block_carry: f32,
+    count: u32,
     sum: f32,
     carry: f32,
 }
@@ -235,28 +269,56 @@ pub struct CompensatedSum {
 impl CompensatedSum {
     /// An empty sum.
     pub fn new() -> Self {
-        Self { sum: 0.0, carry: 0.0 }
+        Self { block: 0.0, block_carry: 0.0, count: 0, sum: 0.0, carry: 0.0 }
     }
 
     /// Adds `x`.
     #[inline]
     pub fn add(&mut self, x: f32) {
-        let y = x - self.carry;
-        let t = self.sum + y;
-        self.carry = (t - self.sum) - y;
-        self.sum = t;
+        kahan!(self.block, self.block_carry, x);
+        self.count += 1;
+        if self.count == SUM_BLOCK {
+            self.flush();
+        }
+    }
+
+    #[inline]
+    fn flush(&mut self) {
+        kahan!(self.sum, self.carry, self.block);
+        self.block = 0.0;
+        self.block_carry = 0.0;
+        self.count = 0;
     }
 
     /// The compensated total.
     #[inline]
     pub fn total(&self) -> f32 {
-        self.sum
+        let mut s = *self;
+        s.flush();
+        s.sum
+    }
+
+    /// A sum that continues from `parts()` of an earlier one (a previous chunk).
+    #[inline]
+    pub fn resume(sum: f32, carry: f32) -> Self {
+        Self { block: 0.0, block_carry: 0.0, count: 0, sum, carry }
+    }
+
+    /// `(sum, carry)` after flushing the current block: all a later chunk needs.
+    #[inline]
+    pub fn parts(&self) -> (f32, f32) {
+        let mut s = *self;
+        s.flush();
+        (s.sum, s.carry)
     }
 }
 
 /// [`CompensatedSum`] for four channels at once.
 #[derive(Copy, Clone, Default)]
 pub struct CompensatedSum4 {
+    block: Vec4,
+    block_carry: Vec4,
+    count: u32,
     sum: Vec4,
     carry: Vec4,
 }
@@ -264,21 +326,76 @@ pub struct CompensatedSum4 {
 impl CompensatedSum4 {
     /// An empty sum.
     pub fn new() -> Self {
-        Self { sum: Vec4::ZERO, carry: Vec4::ZERO }
+        Self { block: Vec4::ZERO, block_carry: Vec4::ZERO, count: 0, sum: Vec4::ZERO, carry: Vec4::ZERO }
     }
 
     /// Adds `x`.
     #[inline]
     pub fn add(&mut self, x: Vec4) {
-        let y = x - self.carry;
-        let t = self.sum + y;
-        self.carry = (t - self.sum) - y;
-        self.sum = t;
+        kahan!(self.block, self.block_carry, x);
+        self.count += 1;
+        if self.count == SUM_BLOCK {
+            self.flush();
+        }
+    }
+
+    #[inline]
+    fn flush(&mut self) {
+        kahan!(self.sum, self.carry, self.block);
+        self.block = Vec4::ZERO;
+        self.block_carry = Vec4::ZERO;
+        self.count = 0;
     }
 
     /// The compensated total.
     #[inline]
     pub fn total(&self) -> Vec4 {
-        self.sum
+        let mut s = *self;
+        s.flush();
+        s.sum
+    }
+
+    /// A sum that continues from `parts()` of an earlier one (a previous chunk).
+    #[inline]
+    pub fn resume(sum: Vec4, carry: Vec4) -> Self {
+        Self { block: Vec4::ZERO, block_carry: Vec4::ZERO, count: 0, sum, carry }
+    }
+
+    /// `(sum, carry)` after flushing the current block.
+    #[inline]
+    pub fn parts(&self) -> (Vec4, Vec4) {
+        let mut s = *self;
+        s.flush();
+        (s.sum, s.carry)
+    }
+}
+
+/// Most loop iterations one shader invocation runs: long sums are split into chunks of
+/// at most this many terms, one dispatch each, carrying their compensated partial sums
+/// between dispatches. Mesa's llvmpipe/lavapipe stops *all* loops of an invocation after
+/// 65 535 iterations in total (`LP_MAX_TGSI_LOOP_ITERATIONS`, "shared between every loop
+/// in a shader"); without chunks a 1024-sample prefilter came out as NaN there. A multiple
+/// of `SUM_BLOCK`, so chunk boundaries fall on block boundaries and chunked sums are the
+/// same arithmetic as one long sum.
+pub const CHUNK: u32 = 16 * SUM_BLOCK;
+
+/// The compensated partial sums of a weighted mean `Σ L·w / Σ w`, carried from chunk to
+/// chunk (see [`CHUNK`]): the value sum and its carry, and the weight sum and carry in
+/// `weight.xy`.
+#[derive(Copy, Clone, Debug, Default, PartialEq)]
+pub struct MeanPartial {
+    /// Σ L·w.
+    pub sum: Vec4,
+    /// Its compensation.
+    pub carry: Vec4,
+    /// Σ w in `x`, its compensation in `y`.
+    pub weight: Vec4,
+}
+
+impl MeanPartial {
+    /// The mean (0 when no term had weight), kept finite (see [`finite4`]).
+    #[inline]
+    pub fn resolve(&self) -> Vec4 {
+        if self.weight.x > 0.0 { finite4(self.sum / self.weight.x) } else { Vec4::ZERO }
     }
 }

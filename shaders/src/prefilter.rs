@@ -18,7 +18,7 @@
 
 use crate::brdf::{alpha_from_roughness, microfacet};
 use crate::cubemap::{self, CubeLayout};
-use crate::math;
+use crate::math::{self, MeanPartial};
 use crate::sampling;
 use spirv_std::glam::{Vec3, Vec4};
 
@@ -74,36 +74,85 @@ pub fn source_lod(pdf: f32, samples: u32, src_size: u32, bias: f32) -> f32 {
     0.5 * math::log2(ratio) + bias
 }
 
-/// Prefiltered radiance in direction `n` (unit) for perceptual `roughness`, from `samples`
-/// GGX samples over the source cube `src`, source levels chosen with `lod_bias`.
+/// Prefiltered radiance in direction `n` for perceptual `roughness`, from `samples` GGX
+/// samples over the source cube `src`, source levels chosen with `lod_bias`: [`accumulate`]
+/// over chunks of `math::CHUNK` samples, then the weighted mean.
 pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, samples: u32, lod_bias: f32) -> Vec4 {
     let alpha = alpha_from_roughness(math::saturate(roughness));
     if alpha == 0.0 {
-        return cubemap::sample_bilinear(src, layout, 0, n);
+        return cubemap::sample_bilinear(src, layout, 0, sampling::normalize_or(n, Vec3::Z));
     }
     let count = samples.max(1);
-    let mut acc = math::CompensatedSum4::new();
-    let mut wsum = math::CompensatedSum::new();
-    let mut i = 0u32;
-    while i < count {
-        let h = sampling::sample_ggx(sampling::hammersley(i, count), alpha, n);
+    let mut p = MeanPartial::default();
+    let mut start = 0u32;
+    while start < count {
+        let c = if count - start < math::CHUNK { count - start } else { math::CHUNK };
+        p = accumulate(src, layout, n, roughness, count, start, c, lod_bias, p);
+        start += c;
+    }
+    p.resolve()
+}
+
+/// Adds GGX samples `start .. start + count` (of `samples` in all) around `n` to `p`.
+#[allow(clippy::too_many_arguments)]
+pub fn accumulate(
+    src: &[Vec4],
+    layout: CubeLayout,
+    n: Vec3,
+    roughness: f32,
+    samples: u32,
+    start: u32,
+    count: u32,
+    lod_bias: f32,
+    p: MeanPartial,
+) -> MeanPartial {
+    // A zero or non-finite direction is read as +z rather than turned into NaN.
+    let n = sampling::normalize_or(n, Vec3::Z);
+    let alpha = alpha_from_roughness(math::saturate(roughness));
+    let total = samples.max(1);
+    // Weights n·l/N sum to at most 1: no overflow, whatever the radiance.
+    let inv_count = 1.0 / total as f32;
+    let mut acc = math::CompensatedSum4::resume(p.sum, p.carry);
+    let mut wsum = math::CompensatedSum::resume(p.weight.x, p.weight.y);
+    let (t, b) = sampling::orthonormal_basis(n);
+    let mut i = start;
+    let end = start + count;
+    while i < end {
+        let ht = sampling::sample_ggx_tangent(sampling::hammersley(i, total), alpha);
+        let h = t * ht.x + b * ht.y + n * ht.z;
         let n_dot_h = n.dot(h);
         let l = h * (2.0 * n_dot_h) - n;
         let n_dot_l = n.dot(l);
         if n_dot_l > 0.0 {
             let pdf = 0.25 * microfacet::d_ggx(n_dot_h, alpha);
-            let lod = source_lod(pdf, count, layout.size, lod_bias);
-            acc.add(cubemap::sample_lod(src, layout, l, lod) * n_dot_l);
-            wsum.add(n_dot_l);
+            let lod = source_lod(pdf, total, layout.size, lod_bias);
+            let w = n_dot_l * inv_count;
+            acc.add(cubemap::sample_lod(src, layout, l, lod) * w);
+            wsum.add(w);
         }
         i += 1;
     }
-    acc.total() * (1.0 / wsum.total())
+    let (sum, carry) = acc.parts();
+    let (w, wc) = wsum.parts();
+    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
 }
 
-/// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`. At
-/// roughness 0 it is the texel of the source level of the same size, bit for bit (or a
-/// bilinear lookup of level 0 if the source has no level that size).
+/// At roughness 0 (a mirror) texel `(x, y)` of `face` of a `dst_size`-wide level is the
+/// texel of the source level of that size, bit for bit, if the source has one.
+pub fn mirror_texel(src: &[Vec4], layout: CubeLayout, face: u32, x: u32, y: u32, dst_size: u32) -> Option<Vec4> {
+    let mut level = 0;
+    while level < layout.levels {
+        if layout.level_size(level) == dst_size {
+            return Some(src[layout.index(level, face, x, y) as usize]);
+        }
+        level += 1;
+    }
+    None
+}
+
+/// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`: the source
+/// texel itself at roughness 0 ([`mirror_texel`]), else [`prefilter_dir`] at the texel
+/// centre.
 pub fn prefilter_texel(
     src: &[Vec4],
     layout: CubeLayout,
@@ -116,12 +165,8 @@ pub fn prefilter_texel(
     lod_bias: f32,
 ) -> Vec4 {
     if roughness <= 0.0 {
-        let mut level = 0;
-        while level < layout.levels {
-            if layout.level_size(level) == dst_size {
-                return src[layout.index(level, face, x, y) as usize];
-            }
-            level += 1;
+        if let Some(t) = mirror_texel(src, layout, face, x, y, dst_size) {
+            return t;
         }
     }
     let n = cubemap::texel_dir(face, x, y, dst_size);

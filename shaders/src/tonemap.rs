@@ -42,6 +42,11 @@ pub fn luminance(c: Vec3) -> f32 {
 /// Narkowicz's ACES filmic curve on one channel, clamped to [0, 1].
 #[inline]
 pub fn aces(x: f32) -> f32 {
+    // Above 10⁴ the curve is 1 to f32 precision; the cut also keeps x² finite (and ∞/∞
+    // away) for any input. NaN maps to 0.
+    if x > 1e4 {
+        return 1.0;
+    }
     let x = math::max(x, 0.0);
     math::saturate(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14))
 }
@@ -49,6 +54,9 @@ pub fn aces(x: f32) -> f32 {
 /// Reinhard's curve on one channel.
 #[inline]
 pub fn reinhard(x: f32) -> f32 {
+    if x > 1e30 {
+        return 1.0;
+    }
     let x = math::max(x, 0.0);
     x / (1.0 + x)
 }
