@@ -93,7 +93,7 @@ impl Backend {
         // Rows per submission: about 2²⁶ sample evaluations each, so that no single
         // submission runs long enough to trip a display driver's watchdog.
         let per_row = size as u64 * samples.min(CHUNK) as u64;
-        let rows = ((1u64 << 26) / per_row).clamp(8, size as u64) as u32;
+        let rows = ((1u64 << 26) / per_row).clamp(1, size as u64) as u32;
         let rows = rows.div_ceil(kernels::TILE) * kernels::TILE;
         for (start, count) in chunks(samples) {
             let mut row = 0;

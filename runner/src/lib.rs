@@ -14,9 +14,11 @@ pub mod files;
 pub mod gpu;
 pub mod ktx2;
 pub mod model;
+pub mod plot;
 pub mod preview;
 pub mod raster;
 pub mod render;
+pub mod report;
 pub mod texture;
 pub mod view;
 

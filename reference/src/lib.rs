@@ -1,6 +1,13 @@
-//! Independent f64 references. None of them calls the code under test: they use other
-//! formulas (textbook forms, not the numerically rearranged ones), other
-//! parametrisations and deterministic quadrature instead of Hammersley sampling.
+//! # splitsum-reference
+//!
+//! Independent references for splitsum's tests and `runner report`, in f64. None of them
+//! calls the code under test: they use other formulas (textbook forms, not the
+//! numerically rearranged ones), other parametrisations (Driscoll's corner formula for
+//! texel solid angles, the OpenGL face table inverted by hand), and deterministic
+//! quadrature or exact sums instead of Hammersley sampling. The only thing shared with the
+//! code under test is the data: texel values of a cube, read as `glam::Vec4`.
+
+pub mod quadrature;
 
 use crate::quadrature::adaptive;
 use std::f64::consts::PI;
@@ -149,4 +156,44 @@ pub fn irradiance(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3]) -> [f64; 3]
         }
     }
     acc.map(|v| v / PI)
+}
+
+/// Reflected radiance towards `v` of a glTF metallic–roughness surface with normal `n`,
+/// lit by every texel of an environment (`texels` from [`texels`]), by the full
+/// reflectance integral with no split:
+///
+/// `L_o = Σ f(l, v) L(l) max(0, n·l) Ω`, with
+/// `f = (1 − F(v·h))(1 − metallic)·base/π + D(h) G(l, v) F(v·h) / (4 (n·l)(n·v))`,
+/// GGX `D` (α = r²) in its textbook form, Smith–Schlick `G` with `k = α/2` (the remapping
+/// the split sum's table uses), Schlick `F` with `F₀ = mix(0.04, base, metallic)`.
+pub fn shade_full(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3], v: [f64; 3], base: [f64; 3], metallic: f64, roughness: f64) -> [f64; 3] {
+    let a2 = (roughness * roughness).powi(2);
+    let k = roughness * roughness / 2.0;
+    let nv = dot(n, v);
+    let f0: [f64; 3] = std::array::from_fn(|c| 0.04 + (base[c] - 0.04) * metallic);
+    let g1 = |x: f64| x / (x * (1.0 - k) + k);
+    let mut out = [0.0; 3];
+    for (l, omega, radiance) in texels {
+        let nl = dot(n, *l);
+        if nl <= 0.0 {
+            continue;
+        }
+        let h = normalize([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
+        let nh = dot(n, h);
+        let vh = dot(v, h).max(0.0);
+        let d = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
+        let g = g1(nv) * g1(nl);
+        let fc = (1.0 - vh).powi(5);
+        for c in 0..3 {
+            let f = f0[c] + (1.0 - f0[c]) * fc;
+            let brdf = (1.0 - f) * (1.0 - metallic) * base[c] / PI + d * g * f / (4.0 * nl * nv);
+            out[c] += brdf * radiance[c] * nl * omega;
+        }
+    }
+    out
+}
+
+/// Rec. 709 luminance.
+pub fn luminance(c: [f64; 3]) -> f64 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
