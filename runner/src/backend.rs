@@ -187,16 +187,23 @@ impl Backend {
     /// The prefiltered specular cube with layout `out`, level `m` filtered for
     /// `roughness[m]` with `samples` GGX samples and source-level bias `lod_bias`.
     pub fn prefilter(&self, src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Result<Cube> {
+        let all: Vec<u32> = (0..out.levels).collect();
+        self.prefilter_levels(src, out, roughness, &all, samples, lod_bias)
+    }
+
+    /// As [`Backend::prefilter`], baking only `levels` (the other levels stay zero: a plan
+    /// leaves out what nothing reads).
+    pub fn prefilter_levels(&self, src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32], samples: u32, lod_bias: f32) -> Result<Cube> {
         if samples == 0 {
             return Err(Error::Invalid("--samples must be at least 1".into()));
         }
         let g = match self {
-            Backend::Cpu => return Ok(cpu::prefilter(src, out, roughness, samples, lod_bias)),
+            Backend::Cpu => return Ok(cpu::prefilter(src, out, roughness, levels, samples, lod_bias)),
             Backend::Gpu(g) => g,
         };
         let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
         let accum = g.output("specular sums", out.texel_count() as u64 * 48)?;
-        for m in 0..out.levels {
+        for &m in levels {
             let r = roughness[m as usize];
             if r <= 0.0 {
                 continue; // a mirror: resolved from the source below
@@ -232,6 +239,10 @@ impl Backend {
         for m in 0..out.levels {
             let s = out.level_size(m);
             let r = roughness[m as usize];
+            if !levels.contains(&m) {
+                texels.resize(texels.len() + (FACES * s * s) as usize, Vec4::ZERO);
+                continue;
+            }
             for face in 0..FACES {
                 for y in 0..s {
                     for x in 0..s {

@@ -447,3 +447,94 @@ pub fn bake_for_display(backend: &Backend, env: &Environment, settings: &Setting
         mapping: settings.mapping.into(),
     })
 }
+
+/// What happened to a scene's bake.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Found in the cache: nothing baked.
+    CacheHit,
+    /// Baked (and stored, when there is a cache).
+    Baked,
+    /// The cache held an entry that could not be used (why); baked again.
+    Rebuilt(String),
+    /// `--force`: baked again regardless of the cache.
+    Forced,
+}
+
+/// A scene's bake: the plan, the products and how they were obtained.
+pub struct SceneBake {
+    /// The plan.
+    pub plan: crate::plan::Plan,
+    /// The products the display reads (stand-ins for what the plan left out).
+    pub env: crate::render::BakedEnvironment,
+    /// Cache key.
+    pub key: String,
+    /// Cache hit, baked, or rebuilt.
+    pub outcome: Outcome,
+    /// Wall time per product (empty on a cache hit).
+    pub timings: Vec<Timing>,
+}
+
+/// A 1×1 cube of zeros: the stand-in for a product a plan leaves out (nothing reads it).
+pub fn empty_cube() -> Cube {
+    Cube { layout: CubeLayout::new(1, 1), texels: vec![Default::default(); 6] }
+}
+
+/// Bakes what `plan` keeps of `env` into what the display reads.
+pub fn bake_plan(backend: &Backend, env: &Environment, plan: &crate::plan::Plan) -> Result<(crate::render::BakedEnvironment, Vec<Timing>)> {
+    let s = &plan.settings;
+    s.validate()?;
+    let mut timings = Vec::new();
+    let source = timed(&mut timings, "source cube", || source_cube(backend, env, s))?;
+    let specular = if plan.products.specular {
+        timed(&mut timings, "specular", || backend.prefilter_levels(&source, s.specular_layout(), &s.roughness(), &plan.levels, s.samples, s.lod_bias))?
+    } else {
+        empty_cube()
+    };
+    let irradiance = if plan.products.irradiance {
+        let level = level_of_size(source.layout, s.irradiance_source);
+        timed(&mut timings, "irradiance", || backend.irradiance(&source, level, s.irradiance_size))?
+    } else {
+        empty_cube()
+    };
+    let lut = if plan.products.lut {
+        timed(&mut timings, "brdf lut", || backend.brdf_lut(s.lut_size, s.lut_samples))?
+    } else {
+        Lut { size: 1, texels: vec![Default::default()] }
+    };
+    let source = Cube { layout: CubeLayout::new(source.layout.size, 1), texels: source.level(0).to_vec() };
+    Ok((crate::render::BakedEnvironment { source, specular, irradiance, lut, mapping: s.mapping.into() }, timings))
+}
+
+/// Plans `scene` and bakes it, or takes it from `cache` when an entry for exactly this
+/// input, plan, backend and shader build is there (`force` bakes regardless).
+pub fn bake_scene(
+    backend: &Backend,
+    scene: &crate::scene::Scene,
+    cal: &crate::plan::Calibration,
+    cache: Option<&crate::cache::Cache>,
+    force: bool,
+) -> Result<SceneBake> {
+    let env_path = scene.environment.as_ref().map(|p| scene.resolve(p));
+    let (env, _) = match &env_path {
+        Some(p) => crate::environment::load(p, scene.sanitize)?,
+        None => (crate::environment::embedded_default()?, Default::default()),
+    };
+    let identity = crate::environment::identity_bytes(env_path.as_deref())?;
+    let plan = crate::plan::plan_for(scene, &env, cal);
+    let plan_json = serde_json::to_string(&(&plan.settings, &plan.products, &plan.levels, scene.sanitize)).expect("serialisable");
+    let key = crate::cache::key(&identity, &plan_json, &backend.describe());
+    let mut outcome = if force { Outcome::Forced } else { Outcome::Baked };
+    if let (Some(c), false) = (cache, force) {
+        match c.get(&key) {
+            crate::cache::Lookup::Hit(env) => return Ok(SceneBake { plan, env: *env, key, outcome: Outcome::CacheHit, timings: Vec::new() }),
+            crate::cache::Lookup::Miss => {}
+            crate::cache::Lookup::Rejected(why) => outcome = Outcome::Rebuilt(why),
+        }
+    }
+    let (baked, timings) = bake_plan(backend, &env, &plan)?;
+    if let Some(c) = cache {
+        c.put(&key, &baked)?;
+    }
+    Ok(SceneBake { plan, env: baked, key, outcome, timings })
+}

@@ -6,6 +6,7 @@ use crate::bake::{self, Mapping, Products, Settings};
 use crate::environment;
 use crate::files;
 use crate::ktx2::Format;
+use crate::scene::{DiffuseArg, FresnelArg, SpecularArg, TonemapArg};
 use crate::{Backend, BackendKind};
 use splitsum_shaders::cubemap::CubeLayout;
 use std::path::PathBuf;
@@ -33,6 +34,64 @@ enum Command {
     /// Measure error against run time of every product on every backend (report.md,
     /// report.csv, error_vs_time.png).
     Report(ReportArgs),
+    /// Show what a scene needs baked and why, what is left out and why, and the cost.
+    Plan(PlanArgs),
+}
+
+/// How a scene's bake is found or made.
+#[derive(Args, Clone)]
+pub struct SceneArgs {
+    /// A scene file (TOML): bake only what it needs, from the cache when unchanged.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Bake again even if the cache holds this bake.
+    #[arg(long)]
+    pub force: bool,
+    /// The cache folder [default: $SPLITSUM_CACHE, $XDG_CACHE_HOME/splitsum or ~/.cache/splitsum].
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Error and cost measurements to plan with (a report.csv of `runner report`)
+    /// [default: built in].
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+}
+
+impl SceneArgs {
+    fn calibration(&self) -> anyhow::Result<crate::plan::Calibration> {
+        match &self.calibration {
+            None => Ok(crate::plan::Calibration::default()),
+            Some(p) => {
+                let text = std::fs::read_to_string(p).map_err(|e| crate::Error::file(p, format!("cannot read: {e}")))?;
+                crate::plan::Calibration::from_report_csv(&text)
+                    .ok_or_else(|| crate::Error::file(p, "is not a report.csv of `runner report` (no brdf lut, prefilter and irradiance rows)").into())
+            }
+        }
+    }
+
+    /// Loads the scene, plans it and bakes it (or takes it from the cache), saying which.
+    fn bake(&self, scene_path: &std::path::Path, backend: &Backend) -> anyhow::Result<(crate::scene::Scene, bake::SceneBake)> {
+        let scene = crate::scene::Scene::load(scene_path)?;
+        let cache = crate::cache::Cache::new(self.cache.clone().unwrap_or_else(crate::cache::default_dir));
+        let start = Instant::now();
+        let sb = bake::bake_scene(backend, &scene, &self.calibration()?, Some(&cache), self.force)?;
+        let short = &sb.key[..12];
+        match &sb.outcome {
+            bake::Outcome::CacheHit => println!("cache hit {short}: nothing to bake ({})", cache.entry(&sb.key).display()),
+            bake::Outcome::Baked => println!("baked {} on {} in {:.2} s; cached as {short}", scene_path.display(), backend.describe(), start.elapsed().as_secs_f64()),
+            bake::Outcome::Forced => println!("baked again (--force) in {:.2} s; cached as {short}", start.elapsed().as_secs_f64()),
+            bake::Outcome::Rebuilt(why) => println!("cache entry {short} rejected ({why}); baked again in {:.2} s", start.elapsed().as_secs_f64()),
+        }
+        Ok((scene, sb))
+    }
+}
+
+#[derive(Args)]
+struct PlanArgs {
+    /// The scene file.
+    scene: PathBuf,
+    /// Error and cost measurements to plan with (a report.csv) [default: built in].
+    #[arg(long)]
+    calibration: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -54,6 +113,8 @@ struct ReportArgs {
 struct ViewArgs {
     /// The environment (equirect .hdr/.exr or a six-face folder) [default: the embedded courtyard].
     env: Option<PathBuf>,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Window width.
     #[arg(long, default_value_t = 960)]
     width: u32,
@@ -114,55 +175,10 @@ pub struct LookArgs {
     pub no_grid: bool,
 }
 
-/// Diffuse models.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum DiffuseArg {
-    /// ρ/π.
-    Lambert,
-    /// Oren–Nayar, σ = roughness.
-    OrenNayar,
-    /// Ashikhmin–Shirley's Fresnel-weighted diffuse.
-    FresnelWeighted,
-}
-
-/// Specular models.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum SpecularArg {
-    /// GGX, Smith–Schlick, Fresnel.
-    CookTorrance,
-    /// Normalised Phong.
-    Phong,
-    /// Normalised Blinn–Phong.
-    BlinnPhong,
-    /// No specular.
-    None,
-}
-
-/// Fresnel forms.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum FresnelArg {
-    /// Schlick.
-    Schlick,
-    /// UE4's spherical Gaussian.
-    SphericalGaussian,
-}
-
-/// Tone curves.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum TonemapArg {
-    /// Narkowicz's ACES fit.
-    Aces,
-    /// Reinhard.
-    Reinhard,
-    /// Clamp.
-    Clamp,
-}
-
 impl LookArgs {
     /// The view these flags describe, with `auto_exposure` from the environment.
     pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
-        use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
-        use splitsum_shaders::tonemap::Tonemapper;
+        use splitsum_shaders::shade::ShadeOptions;
         let mut flags = 0;
         if !self.no_ibl {
             flags |= ShadeOptions::IBL;
@@ -176,30 +192,9 @@ impl LookArgs {
             yaw: self.yaw.to_radians(),
             pitch: self.pitch.to_radians(),
             exposure: auto_exposure * 2f32.powf(self.exposure),
-            tonemapper: match self.tonemapper {
-                TonemapArg::Aces => Tonemapper::Aces,
-                TonemapArg::Reinhard => Tonemapper::Reinhard,
-                TonemapArg::Clamp => Tonemapper::Clamp,
-            },
+            tonemapper: self.tonemapper.curve(),
             sky_blur: self.sky_blur,
-            options: ShadeOptions {
-                diffuse: match self.diffuse {
-                    DiffuseArg::Lambert => diffuse_model::LAMBERT,
-                    DiffuseArg::OrenNayar => diffuse_model::OREN_NAYAR,
-                    DiffuseArg::FresnelWeighted => diffuse_model::FRESNEL_WEIGHTED,
-                },
-                specular: match self.specular {
-                    SpecularArg::CookTorrance => specular_model::COOK_TORRANCE,
-                    SpecularArg::Phong => specular_model::PHONG,
-                    SpecularArg::BlinnPhong => specular_model::BLINN_PHONG,
-                    SpecularArg::None => specular_model::NONE,
-                },
-                fresnel: match self.fresnel {
-                    FresnelArg::Schlick => fresnel_model::SCHLICK,
-                    FresnelArg::SphericalGaussian => fresnel_model::SPHERICAL_GAUSSIAN,
-                },
-                flags,
-            },
+            options: ShadeOptions { diffuse: self.diffuse.code(), specular: self.specular.code(), fresnel: self.fresnel.code(), flags },
             ..Default::default()
         };
         view.frame_contents();
@@ -260,6 +255,8 @@ impl DisplayBakeArgs {
 struct RenderArgs {
     /// The environment (equirect .hdr/.exr or a six-face folder) [default: the embedded courtyard].
     env: Option<PathBuf>,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Output PNG.
     #[arg(long, default_value = "frame.png")]
     out: PathBuf,
@@ -349,8 +346,11 @@ impl QualityArgs {
 #[derive(Args)]
 struct BakeArgs {
     /// The environment: an equirectangular .hdr or .exr, or a folder holding six faces
-    /// px nx py ny pz nz (.hdr or .exr) in Vulkan/KTX2 orientation.
-    env: PathBuf,
+    /// px nx py ny pz nz (.hdr or .exr) in Vulkan/KTX2 orientation (or --scene).
+    #[arg(required_unless_present = "scene")]
+    env: Option<PathBuf>,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// Output folder (created if missing).
     #[arg(long, default_value = "out")]
     out: PathBuf,
@@ -412,6 +412,7 @@ where
         Some(Command::Render(args)) => render(args),
         Some(Command::View(args)) => view(args),
         Some(Command::Report(args)) => report(args),
+        Some(Command::Plan(args)) => plan_command(args),
         None => default_run(),
     }
 }
@@ -444,25 +445,34 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
 }
 
 fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
+    if let Some(scene_path) = &args.scene.scene {
+        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        std::fs::create_dir_all(&args.out).map_err(|e| crate::Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
+        files::check_writable(&args.out.join("bake.json"))?;
+        let backend = Backend::open(args.backend)?;
+        let (_, sb) = args.scene.bake(scene_path, &backend)?;
+        return write_scene_bake(&args.out, &sb, &args.quality.format);
+    }
+    let env_path = args.env.clone().expect("clap requires ENV without --scene");
     let settings = args.quality.settings();
     settings.validate()?;
     std::fs::create_dir_all(&args.out).map_err(|e| crate::Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
     files::check_writable(&args.out.join("bake.json"))?;
-    let (env, input) = environment::load(&args.env, args.sanitize)?;
+    let (env, input) = environment::load(&env_path, args.sanitize)?;
     if input.negative > 0 {
-        eprintln!("note: {}: {} texels had negative values, set to 0", args.env.display(), input.negative);
+        eprintln!("note: {}: {} texels had negative values, set to 0", env_path.display(), input.negative);
     }
     if input.clamped > 0 {
-        eprintln!("note: {}: {} texels were brighter than 1e20 and were clamped to it", args.env.display(), input.clamped);
+        eprintln!("note: {}: {} texels were brighter than 1e20 and were clamped to it", env_path.display(), input.clamped);
     }
     if input.sanitized && (input.nan > 0 || input.infinite > 0) {
-        eprintln!("note: {}: replaced {} NaN and {} infinite texels (--sanitize)", args.env.display(), input.nan, input.infinite);
+        eprintln!("note: {}: replaced {} NaN and {} infinite texels (--sanitize)", env_path.display(), input.nan, input.infinite);
     }
     let backend = Backend::open(args.backend)?;
-    println!("baking {} on {}", args.env.display(), backend.describe());
+    println!("baking {} on {}", env_path.display(), backend.describe());
     let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
     let manifest = bake::Manifest {
-        environment: args.env.display().to_string(),
+        environment: env_path.display().to_string(),
         backend: backend.describe(),
         settings: settings.clone(),
         roughness_per_mip: settings.roughness(),
@@ -547,8 +557,22 @@ pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyho
 }
 
 fn render(args: RenderArgs) -> anyhow::Result<()> {
-    crate::render::check_size(args.width, args.height)?;
     files::check_writable(&args.out)?;
+    if let Some(scene_path) = &args.scene.scene {
+        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        let backend = Backend::open(args.backend)?;
+        let (scene, sb) = args.scene.bake(scene_path, &backend)?;
+        let view = scene.view(sb.env.auto_exposure());
+        let model = scene.model()?;
+        let (w, h) = (scene.output.width, scene.output.height);
+        let start = Instant::now();
+        let pixels = render_frame(&backend, &sb.env, &view.frame(sb.env.shape(), w, h, true), model.as_ref())?;
+        files::write_png(&args.out, w, h, &crate::render::to_rgb8(&pixels))?;
+        println!("rendered {w}×{h} in {:.3} s: {}", start.elapsed().as_secs_f64(), view.summary());
+        println!("wrote {}", args.out.display());
+        return Ok(());
+    }
+    crate::render::check_size(args.width, args.height)?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();
@@ -558,15 +582,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let model = args.look.load_model()?;
     let start = Instant::now();
     let frame = view.frame(baked.shape(), args.width, args.height, true);
-    let pixels = match (&backend, &model) {
-        (Backend::Gpu(g), m) => {
-            let scene = crate::render::GpuScene::new(g, &baked);
-            let gm = m.as_ref().map(|m| crate::render::GpuModel::new(g, &scene, m));
-            scene.render_offscreen(g, &frame, gm.as_ref())?
-        }
-        (Backend::Cpu, Some(m)) => crate::raster::render(&baked, &frame, m),
-        (Backend::Cpu, None) => crate::render::render_cpu(&baked, &frame),
-    };
+    let pixels = render_frame(&backend, &baked, &frame, model.as_ref())?;
     let render_secs = start.elapsed().as_secs_f64();
     files::write_png(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels))?;
     println!("{name} on {}: bake {bake_secs:.2} s, render {render_secs:.3} s", backend.describe());
@@ -578,6 +594,21 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
 fn view(args: ViewArgs) -> anyhow::Result<()> {
     if !crate::view::display_available() {
         anyhow::bail!("no display (neither DISPLAY nor WAYLAND_DISPLAY is set); `runner render --out frame.png` renders without one");
+    }
+    if let Some(scene_path) = &args.scene.scene {
+        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        let backend = Backend::open(BackendKind::Gpu)?;
+        let (scene, sb) = args.scene.bake(scene_path, &backend)?;
+        let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
+        let state = scene.view(sb.env.auto_exposure());
+        let model = scene.model()?;
+        let options = crate::view::ViewOptions {
+            exit_after: args.exit_after.map(std::time::Duration::from_secs_f64),
+            size: (scene.output.width, scene.output.height),
+            ..Default::default()
+        };
+        crate::view::run(*gpu, &sb.env, model.as_ref(), state, options)?;
+        return Ok(());
     }
     crate::render::check_size(args.width, args.height)?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
@@ -670,13 +701,80 @@ fn report(args: ReportArgs) -> anyhow::Result<()> {
         }
     }
     anyhow::ensure!(!backends.is_empty(), "no backend could be opened");
-    let plan = if args.quick { crate::report::Plan::quick() } else { crate::report::Plan::full() };
+    let sweep = if args.quick { crate::report::Sweep::quick() } else { crate::report::Sweep::full() };
     let start = Instant::now();
-    let rows = crate::report::run(&env, &name, &backends, &plan, &args.out)?;
+    let rows = crate::report::run(&env, &name, &backends, &sweep, &args.out)?;
     println!("{} measurements in {:.1} s", rows.len(), start.elapsed().as_secs_f64());
     for r in crate::report::best_per_ms(&rows) {
         println!("  best error per ms: {:<28} {:<8} {:<24} {:>9.1} ms  mean error {:.2e}", r.product, &r.backend[..3], r.setting, r.time_ms, r.mean_error);
     }
     println!("wrote {}/report.md, report.csv, error_vs_time.png", args.out.display());
+    Ok(())
+}
+
+/// Renders `frame` (with `model`, if any) on `backend`: the GPU renderer, or the CPU
+/// reference renderer.
+fn render_frame(
+    backend: &Backend,
+    env: &crate::render::BakedEnvironment,
+    frame: &splitsum_shaders::scene::Frame,
+    model: Option<&crate::model::Model>,
+) -> anyhow::Result<Vec<splitsum_shaders::glam::Vec4>> {
+    Ok(match (backend, model) {
+        (Backend::Gpu(g), m) => {
+            let scene = crate::render::GpuScene::new(g, env);
+            let gm = m.map(|m| crate::render::GpuModel::new(g, &scene, m));
+            scene.render_offscreen(g, frame, gm.as_ref())?
+        }
+        (Backend::Cpu, Some(m)) => crate::raster::render(env, frame, m),
+        (Backend::Cpu, None) => crate::render::render_cpu(env, frame),
+    })
+}
+
+fn plan_command(args: PlanArgs) -> anyhow::Result<()> {
+    let scene = crate::scene::Scene::load(&args.scene)?;
+    let cal = SceneArgs { scene: None, force: false, cache: None, calibration: args.calibration.clone() }.calibration()?;
+    let env_path = scene.environment.as_ref().map(|p| scene.resolve(p));
+    let (env, name) = load_environment(env_path.as_deref(), scene.sanitize)?;
+    let plan = crate::plan::plan_for(&scene, &env, &cal);
+    print!("{}", crate::plan::describe(&plan, &args.scene.display().to_string(), &name));
+    Ok(())
+}
+
+/// Writes a scene's bake: KTX2 of the products the plan kept, the table as EXR, and
+/// `plan.json` (decisions, settings, levels, cache key). `specular.ktx2` holds the baked
+/// mips `first ..= last` only (its mip 0 is level `first`; roughness per mip in
+/// `plan.json`; levels in between that the plan skips are zero).
+fn write_scene_bake(dir: &std::path::Path, sb: &bake::SceneBake, format: &Format) -> anyhow::Result<()> {
+    let p = &sb.plan;
+    let mut written = Vec::new();
+    let all_roughness = p.settings.roughness();
+    let mut specular_roughness = Vec::new();
+    if let (true, Some(&first), Some(&last)) = (p.products.specular, p.levels.first(), p.levels.last()) {
+        crate::ktx2::write(&dir.join("specular.ktx2"), &sb.env.specular.levels(first, last), *format)?;
+        specular_roughness = (first..=last).map(|l| if p.levels.contains(&l) { Some(all_roughness[l as usize]) } else { None }).collect();
+        written.push("specular.ktx2");
+    }
+    if p.products.irradiance {
+        crate::ktx2::write(&dir.join("irradiance.ktx2"), &sb.env.irradiance, *format)?;
+        written.push("irradiance.ktx2");
+    }
+    if p.products.lut {
+        files::write_lut_exr(&dir.join("brdf_lut.exr"), &sb.env.lut)?;
+        written.push("brdf_lut.exr");
+    }
+    #[derive(serde::Serialize)]
+    struct PlanFile<'a> {
+        key: &'a str,
+        plan: &'a crate::plan::Plan,
+        /// Roughness of each mip of specular.ktx2 (null: skipped, zero).
+        specular_roughness_per_mip: Vec<Option<f32>>,
+        timings: &'a [bake::Timing],
+        files: &'a [&'a str],
+    }
+    let file = PlanFile { key: &sb.key, plan: p, specular_roughness_per_mip: specular_roughness, timings: &sb.timings, files: &written };
+    let json = serde_json::to_string_pretty(&file).expect("serialisable");
+    files::write_atomic(&dir.join("plan.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+    println!("wrote {} and plan.json to {}", if written.is_empty() { "nothing to bake".to_string() } else { written.join(", ") }, dir.display());
     Ok(())
 }

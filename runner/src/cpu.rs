@@ -101,12 +101,12 @@ pub fn build_mips(cube: &mut Cube) {
     }
 }
 
-/// Every level of the prefiltered specular cube.
-pub fn prefilter(src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Cube {
+/// Levels `levels` of the prefiltered specular cube (the others stay zero).
+pub fn prefilter(src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32], samples: u32, lod_bias: f32) -> Cube {
     let mut texels = vec![Vec4::ZERO; out.texel_count() as usize];
-    let rows: u64 = (0..out.levels).map(|m| (FACES * out.level_size(m)) as u64).sum();
+    let rows: u64 = levels.iter().map(|&m| (FACES * out.level_size(m)) as u64).sum();
     let bar = progress("specular", rows);
-    for m in 0..out.levels {
+    for &m in levels {
         let s = out.level_size(m);
         let start = out.level_offset(m) as usize;
         let level = &mut texels[start..start + (FACES * s * s) as usize];

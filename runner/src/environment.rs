@@ -266,3 +266,19 @@ pub fn embedded_default() -> Result<Environment> {
     clean(path, &mut texels, false)?;
     Ok(Environment::Equirect(Equirect { width, height, texels }))
 }
+
+/// The bytes that identify an environment for the bake cache: the file's bytes, a face
+/// folder's six files in order, or the embedded default.
+pub fn identity_bytes(path: Option<&Path>) -> Result<Vec<u8>> {
+    match path {
+        None => Ok(EMBEDDED_DEFAULT.to_vec()),
+        Some(p) if p.is_dir() => {
+            let mut all = Vec::new();
+            for f in face_paths(p)? {
+                all.extend(std::fs::read(&f).map_err(|e| Error::file(&f, format!("cannot read: {e}")))?);
+            }
+            Ok(all)
+        }
+        Some(p) => std::fs::read(p).map_err(|e| Error::file(p, format!("cannot read: {e}"))),
+    }
+}

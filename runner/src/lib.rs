@@ -6,6 +6,7 @@
 
 pub mod backend;
 pub mod bake;
+pub mod cache;
 pub mod cli;
 pub mod cpu;
 pub mod environment;
@@ -14,10 +15,12 @@ pub mod files;
 pub mod gpu;
 pub mod ktx2;
 pub mod model;
+pub mod plan;
 pub mod plot;
 pub mod preview;
 pub mod raster;
 pub mod render;
+pub mod scene;
 pub mod report;
 pub mod texture;
 pub mod view;

@@ -77,6 +77,15 @@ impl Model {
         (lo, hi)
     }
 
+    /// Shades every primitive with `options` and clamps its roughness to `roughness` and
+    /// metalness to `metallic` (a scene's material).
+    pub fn set_material(&mut self, options: splitsum_shaders::shade::ShadeOptions, roughness: (f32, f32), metallic: (f32, f32)) {
+        for p in &mut self.primitives {
+            p.material.options = options;
+            p.material.ranges = Vec4::new(roughness.0, roughness.1, metallic.0, metallic.1);
+        }
+    }
+
     /// Moves and scales the model so that its bounding box is centred on `centre` and its
     /// largest side is `size`.
     pub fn fit(&mut self, centre: Vec3, size: f32) {
@@ -216,6 +225,8 @@ fn primitive(path: &Path, prim: &gltf::Primitive, world: Mat4, buffers: &[gltf::
         emissive: Vec3::from(mat.emissive_factor()).extend(mat.normal_texture().map_or(1.0, |t| t.scale())),
         params: Vec4::new(pbr.metallic_factor(), pbr.roughness_factor(), mat.occlusion_texture().map_or(1.0, |t| t.strength()), 0.0),
         textures: splitsum_shaders::glam::UVec4::new(bits, 0, 0, 0),
+        ranges: Vec4::new(0.0, 1.0, 0.0, 1.0),
+        options: splitsum_shaders::shade::ShadeOptions::DEFAULT,
     };
     Ok(Primitive { vertices, indices, material, textures, double_sided: mat.double_sided() })
 }

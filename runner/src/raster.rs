@@ -174,7 +174,7 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
             let texels = Texels { base_color: read(0), metallic_roughness: read(1), normal: read(2), occlusion: read(3), emissive: read(4) };
             let (m, n) = surface::material(&prim.material, &texels, normal, tangent);
             let view = splitsum_shaders::sampling::normalize_or(frame.eye.truncate() - position, n);
-            *c = scene::shade_point(frame, &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &m, position, n, view);
+            *c = scene::shade_point(frame, prim.material.options, &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &m, position, n, view);
         });
     colour.into_iter().map(|c| scene::to_display(frame, c)).collect()
 }

@@ -31,10 +31,19 @@ pub struct BakedEnvironment {
 
 impl BakedEnvironment {
     /// An exposure at which a white Lambert surface shows, on average, at 0.5 before the
-    /// tone curve: `0.5 / mean(E/π)` over the irradiance cube.
+    /// tone curve: `0.5 / mean(E/π)`. The mean of `E/π` over all normals is the
+    /// solid-angle-weighted mean of the radiance (`∫ max(0, n·l) dn = π` for every `l`), so
+    /// it is read from the source cube and does not depend on which products a plan bakes.
     pub fn auto_exposure(&self) -> f32 {
-        let t = &self.irradiance.texels;
-        let mean = t.iter().map(|c| splitsum_shaders::tonemap::luminance(c.truncate()) as f64).sum::<f64>() / t.len().max(1) as f64;
+        let s = self.source.layout.size;
+        let (mut sum, mut weight) = (0.0f64, 0.0f64);
+        for (i, c) in self.source.level(0).iter().enumerate() {
+            let (x, y) = (i as u32 % s, (i as u32 / s) % s);
+            let w = splitsum_shaders::cubemap::texel_solid_angle(x, y, s) as f64;
+            sum += w * splitsum_shaders::tonemap::luminance(c.truncate()) as f64;
+            weight += w;
+        }
+        let mean = sum / weight.max(f64::MIN_POSITIVE);
         if mean > 0.0 { (0.5 / mean) as f32 } else { 1.0 }
     }
 
@@ -82,6 +91,8 @@ pub struct ViewState {
     pub show_model: bool,
     /// Base colour of the spheres.
     pub base_color: Vec3,
+    /// The grid's metalness range (top to bottom row) and roughness range (left to right).
+    pub grid_ranges: Vec4,
     /// Direct lights.
     pub lights: Vec<Light>,
 }
@@ -102,6 +113,7 @@ impl Default for ViewState {
             spheres: true,
             show_model: false,
             base_color: Vec3::new(0.9, 0.45, 0.2),
+            grid_ranges: Vec4::new(0.0, 1.0, 0.0, 1.0),
             lights: vec![
                 Light { position: Vec4::new(-0.5, 0.8, 0.6, 0.0).normalize() * Vec4::new(1.0, 1.0, 1.0, 0.0), radiance: Vec4::new(3.0, 2.9, 2.7, 0.0) },
                 Light { position: Vec4::new(3.0, 2.0, 4.0, 1.0), radiance: Vec4::new(20.0, 20.0, 24.0, 0.0) },
@@ -215,6 +227,7 @@ impl ViewState {
             lights,
             view_proj: perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * look_at(eye, forward, right, up),
             depth_range: Vec4::new(DEPTH_RANGE.0, DEPTH_RANGE.1, 0.0, 0.0),
+            grid_ranges: self.grid_ranges,
         }
     }
 }

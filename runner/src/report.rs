@@ -35,7 +35,7 @@ use std::time::Instant;
 
 /// The sweeps of a report.
 #[derive(Clone, Debug)]
-pub struct Plan {
+pub struct Sweep {
     /// Face size of the source cube everything is filtered from (and the references sum).
     pub source_size: u32,
     /// Face size of mip 0 of the prefiltered cube.
@@ -66,11 +66,11 @@ pub struct Plan {
     pub directions: u32,
 }
 
-impl Plan {
+impl Sweep {
     /// The full report: a few minutes on lavapipe and 2 CPU cores. Its shaded colour also
     /// measures the default bake settings (`Settings::default()`).
     pub fn full() -> Self {
-        let mut plan = Self::with(
+        let mut sweep = Self::with(
             128,
             64,
             32,
@@ -82,8 +82,8 @@ impl Plan {
             vec![8, 16, 32, 64, 128],
             32,
         );
-        plan.qualities.push(("defaults (bake's)".to_string(), Settings::default()));
-        plan
+        sweep.qualities.push(("defaults (bake's)".to_string(), Settings::default()));
+        sweep
     }
 
     /// A quick report for CI: the same sweeps, smaller and shorter.
@@ -194,14 +194,14 @@ fn arr(v: Vec3) -> [f64; 3] {
 
 /// Runs the report's sweeps of `env` on `backends`, writes the three files into `dir`, and
 /// returns the measurements.
-pub fn run(env: &Environment, name: &str, backends: &[Backend], plan: &Plan, dir: &Path) -> Result<Vec<Measurement>> {
+pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, dir: &Path) -> Result<Vec<Measurement>> {
     std::fs::create_dir_all(dir).map_err(|e| crate::Error::file(dir, format!("cannot create the output folder: {e}")))?;
     files::check_writable(&dir.join("report.md"))?;
-    let settings = Settings { source_size: plan.source_size, size: plan.source_size, ..Settings::default() };
+    let settings = Settings { source_size: sweep.source_size, size: sweep.source_size, ..Settings::default() };
     let source = bake::source_cube(&Backend::Cpu, env, &settings)?;
-    let texels = reference::texels(source.level(0), plan.source_size);
+    let texels = reference::texels(source.level(0), sweep.source_size);
     eprintln!("report: references (f64) …");
-    let refs = References::compute(plan, &texels);
+    let refs = References::compute(sweep, &texels);
     let mut rows = Vec::new();
     rows.extend(refs.split_error_rows());
     for backend in backends {
@@ -211,12 +211,12 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], plan: &Plan, dir
         backend.brdf_lut(4, 4)?;
         backend.prefilter(&source, CubeLayout::new(4, 1), &[0.5], 4, 0.0)?;
         backend.irradiance(&source, source.layout.levels - 1, 4)?;
-        rows.extend(lut_rows(backend, &b, plan, &refs)?);
-        rows.extend(prefilter_rows(backend, &b, plan, &refs, &source)?);
-        rows.extend(irradiance_rows(backend, &b, plan, &refs, &source)?);
-        rows.extend(shaded_rows(backend, &b, plan, &refs, env)?);
+        rows.extend(lut_rows(backend, &b, sweep, &refs)?);
+        rows.extend(prefilter_rows(backend, &b, sweep, &refs, &source)?);
+        rows.extend(irradiance_rows(backend, &b, sweep, &refs, &source)?);
+        rows.extend(shaded_rows(backend, &b, sweep, &refs, env)?);
     }
-    write_outputs(dir, name, backends, plan, &rows)?;
+    write_outputs(dir, name, backends, sweep, &rows)?;
     Ok(rows)
 }
 
@@ -249,8 +249,8 @@ struct ShadingPoint {
 }
 
 impl References {
-    fn compute(plan: &Plan, texels: &[([f64; 3], f64, [f64; 3])]) -> Self {
-        let t = plan.lut_size;
+    fn compute(sweep: &Sweep, texels: &[([f64; 3], f64, [f64; 3])]) -> Self {
+        let t = sweep.lut_size;
         let lut: Vec<Vec2> = (0..t * t)
             .into_par_iter()
             .map(|i| {
@@ -267,13 +267,13 @@ impl References {
                 (p, Vec2::new(a as f32, b as f32))
             })
             .collect();
-        let prefilter_dirs = directions(plan.directions);
-        let roughness: Vec<f32> = (0..plan.mips).map(|m| RoughnessMapping::Linear.roughness(m, plan.mips)).collect();
+        let prefilter_dirs = directions(sweep.directions);
+        let roughness: Vec<f32> = (0..sweep.mips).map(|m| RoughnessMapping::Linear.roughness(m, sweep.mips)).collect();
         let prefilter = roughness
             .iter()
             .map(|&r| prefilter_dirs.par_iter().map(|&n| reference::prefilter(texels, arr(n), r as f64)).collect())
             .collect();
-        let irradiance_dirs = directions(2 * plan.directions);
+        let irradiance_dirs = directions(2 * sweep.directions);
         let irradiance = irradiance_dirs.par_iter().map(|&n| reference::irradiance(texels, arr(n))).collect();
         // Shading points: rough enough that a sum over the source's texels resolves the
         // lobe (r ≥ 0.3 on a 64² source), metals and dielectrics, several view angles.
@@ -326,16 +326,16 @@ impl References {
     }
 }
 
-fn lut_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References) -> Result<Vec<Measurement>> {
+fn lut_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
-    for &n in &plan.samples {
-        let (table, ms) = timed(|| backend.brdf_lut(plan.lut_size, n))?;
+    for &n in &sweep.samples {
+        let (table, ms) = timed(|| backend.brdf_lut(sweep.lut_size, n))?;
         let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
         let (mean, max) = mean_max(&errors);
         rows.push(Measurement { product: "brdf lut".into(), backend: b.into(), setting: format!("{n} samples"), time_ms: ms, mean_error: mean, max_error: max, metric: ABS });
     }
-    let n = *plan.samples.last().expect("samples");
-    for &size in &plan.lut_sizes {
+    let n = *sweep.samples.last().expect("samples");
+    for &size in &sweep.lut_sizes {
         let (table, ms) = timed(|| backend.brdf_lut(size, n))?;
         let errors: Vec<f64> = refs
             .lut_points
@@ -356,9 +356,9 @@ fn lut_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References) -> Resul
     Ok(rows)
 }
 
-fn prefilter_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
+fn prefilter_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
-    let roughness: Vec<f32> = (0..plan.mips).map(|m| RoughnessMapping::Linear.roughness(m, plan.mips)).collect();
+    let roughness: Vec<f32> = (0..sweep.mips).map(|m| RoughnessMapping::Linear.roughness(m, sweep.mips)).collect();
     let mut level = |n: u32, bias: f32, m: usize, size: u32, product: String, setting: String| -> Result<()> {
         let layout = CubeLayout::new(size, 1);
         let (cube, ms) = timed(|| backend.prefilter(source, layout, &[roughness[m]], n, bias))?;
@@ -373,29 +373,29 @@ fn prefilter_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References, so
         Ok(())
     };
     let default_bias = Settings::default().lod_bias;
-    for m in 1..plan.mips as usize {
-        let size = (plan.specular_size >> m).max(1);
-        for &n in &plan.samples {
+    for m in 1..sweep.mips as usize {
+        let size = (sweep.specular_size >> m).max(1);
+        for &n in &sweep.samples {
             level(n, default_bias, m, size, format!("prefilter r={:.2}", roughness[m]), format!("{n} samples, bias {default_bias}"))?;
         }
-        for &n in &plan.bias_samples {
-            for &bias in &plan.biases {
+        for &n in &sweep.bias_samples {
+            for &bias in &sweep.biases {
                 level(n, bias, m, size, format!("prefilter r={:.2} bias sweep", roughness[m]), format!("{n} samples, bias {bias}"))?;
             }
         }
     }
-    let n = plan.bias_samples[plan.bias_samples.len() - 1];
-    for &size in &plan.cube_sizes {
+    let n = sweep.bias_samples[sweep.bias_samples.len() - 1];
+    for &size in &sweep.cube_sizes {
         level(n, default_bias, 1, size, format!("prefilter r={:.2} cube size", roughness[1]), format!("{size}x{size}, {n} samples"))?;
     }
     Ok(rows)
 }
 
-fn irradiance_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
+fn irradiance_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
-    for &s in &plan.irradiance_sources {
+    for &s in &sweep.irradiance_sources {
         let level = bake::level_of_size(source.layout, s);
-        let (cube, ms) = timed(|| backend.irradiance(source, level, plan.irradiance_size))?;
+        let (cube, ms) = timed(|| backend.irradiance(source, level, sweep.irradiance_size))?;
         let errors: Vec<f64> = refs
             .irradiance_dirs
             .iter()
@@ -413,7 +413,7 @@ fn irradiance_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References, s
             metric: REL,
         });
     }
-    for &s in &plan.sh_sources {
+    for &s in &sweep.sh_sources {
         let level = bake::level_of_size(source.layout, s);
         let (sh, ms) = timed(|| backend.sh9(source, level))?;
         let coeffs = sh.as_vec4();
@@ -424,10 +424,10 @@ fn irradiance_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References, s
     Ok(rows)
 }
 
-fn shaded_rows(backend: &Backend, b: &str, plan: &Plan, refs: &References, env: &Environment) -> Result<Vec<Measurement>> {
+fn shaded_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, env: &Environment) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
     let products = Products { specular: true, irradiance: true, sh9: false, lut: true };
-    for (label, settings) in &plan.qualities {
+    for (label, settings) in &sweep.qualities {
         let (baked, ms) = timed(|| bake::bake(backend, env, settings, products))?;
         let (spec, irr, table) = (baked.specular.expect("baked"), baked.irradiance.expect("baked"), baked.lut.expect("baked"));
         let shape = EnvironmentShape {
@@ -483,7 +483,7 @@ pub fn best_per_ms(rows: &[Measurement]) -> Vec<&Measurement> {
         .collect()
 }
 
-fn write_outputs(dir: &Path, name: &str, backends: &[Backend], plan: &Plan, rows: &[Measurement]) -> Result<()> {
+fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement]) -> Result<()> {
     // CSV.
     let mut csv = String::from("product,backend,setting,time_ms,mean_error,max_error,metric\n");
     for r in rows {
@@ -494,7 +494,7 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], plan: &Plan, rows
     // Markdown.
     let mut md = String::new();
     let _ = writeln!(md, "# splitsum: error against run time\n");
-    let _ = writeln!(md, "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)).", plan.source_size, plan.specular_size, plan.mips);
+    let _ = writeln!(md, "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)).", sweep.source_size, sweep.specular_size, sweep.mips);
     let _ = writeln!(md, "Backends: {}.\n", backends.iter().map(|b| b.describe()).collect::<Vec<_>>().join("; "));
     let _ = writeln!(md, "References (f64, independent of the code under test): adaptive Gauss-Kronrod quadrature for the BRDF table; exact sums over every texel of the source for the prefilter and the irradiance; the full reflectance integral (no split) for the shaded colour. Errors are absolute for the table and relative luminance otherwise. Times are wall-clock, uploads and readbacks included.\n");
     let mut products: Vec<&str> = Vec::new();

@@ -40,6 +40,14 @@ impl Cube {
         let s = self.layout.level_size(level) as usize;
         &self.texels[start..start + 6 * s * s]
     }
+
+    /// Levels `first ..= last` as a cube of their own (level `first` becomes level 0).
+    pub fn levels(&self, first: u32, last: u32) -> Cube {
+        let layout = CubeLayout::new(self.layout.level_size(first), last - first + 1);
+        let start = self.layout.level_offset(first) as usize;
+        let end = self.layout.level_offset(last + 1) as usize;
+        Cube { layout, texels: self.texels[start..end].to_vec() }
+    }
 }
 
 /// Nine spherical-harmonic coefficients of radiance, RGB (see `splitsum_shaders::irradiance`).

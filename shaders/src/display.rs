@@ -90,6 +90,6 @@ pub fn mesh_fs(
     };
     let (m, n) = surface::material(material, &texels, normal, tangent);
     let v = sampling::normalize_or(frame.eye.truncate() - position, n);
-    let c = scene::shade_point(frame, specular, irradiance, table, &m, position, n, v);
+    let c = scene::shade_point(frame, material.options, specular, irradiance, table, &m, position, n, v);
     *output = scene::to_display(frame, c);
 }

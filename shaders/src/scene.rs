@@ -58,6 +58,9 @@ pub struct Frame {
     pub view_proj: Mat4,
     /// Near and far planes of the projection.
     pub depth_range: Vec4,
+    /// The grid's metalness from the top row to the bottom (`x`, `y`) and roughness from
+    /// the left column to the right (`z`, `w`).
+    pub grid_ranges: Vec4,
 }
 
 impl Frame {
@@ -127,13 +130,16 @@ pub fn hit_grid(frame: &Frame, origin: Vec3, dir: Vec3) -> (f32, u32, u32) {
 }
 
 /// The material of the sphere in `row`, `col`: metalness rises down the rows, roughness
-/// along the columns, each from 0 to 1.
+/// along the columns, over the frame's `grid_ranges`.
 #[inline]
 pub fn grid_material(frame: &Frame, row: u32, col: u32) -> Material {
+    let r = frame.grid_ranges;
     Material {
         base_color: frame.base_color.truncate(),
-        metallic: step(row, frame.grid.x),
-        roughness: step(col, frame.grid.y),
+        // Clamped so that rounding never steps outside the declared range (a plan bakes
+        // only the mips that range reads).
+        metallic: math::clamp(r.x + (r.y - r.x) * step(row, frame.grid.x), r.x, r.y),
+        roughness: math::clamp(r.z + (r.w - r.z) * step(col, frame.grid.y), r.z, r.w),
         occlusion: 1.0,
         emissive: Vec3::ZERO,
     }
@@ -145,11 +151,11 @@ fn step(i: u32, n: u32) -> f32 {
     if n > 1 { i as f32 / (n - 1) as f32 } else { 0.0 }
 }
 
-/// Radiance leaving point `p` (normal `n`) towards the eye along `v`: emission, the
-/// image-based light and every direct light.
-pub fn shade_point(frame: &Frame, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], m: &Material, p: Vec3, n: Vec3, v: Vec3) -> Vec3 {
+/// Radiance leaving point `p` (normal `n`) towards the eye along `v` under the models and
+/// lights of `opts`: emission, the image-based light and every direct light of the frame.
+#[allow(clippy::too_many_arguments)]
+pub fn shade_point(frame: &Frame, opts: ShadeOptions, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], m: &Material, p: Vec3, n: Vec3, v: Vec3) -> Vec3 {
     let mut color = m.emissive;
-    let opts = frame.options;
     if opts.flags & ShadeOptions::IBL != 0 {
         let s = shade::ibl_sample(frame.shape, specular, irradiance, table, n, v, m.roughness);
         color += shade::ibl(opts, m, n, v, s);
@@ -186,7 +192,7 @@ pub fn radiance_depth(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradia
             let m = grid_material(frame, row, col);
             let d = (p - origin).dot(frame.forward.truncate());
             let depth = crate::surface::depth(d, frame.depth_range.x, frame.depth_range.y);
-            return (shade_point(frame, specular, irradiance, table, &m, p, n, -dir), depth);
+            return (shade_point(frame, frame.options, specular, irradiance, table, &m, p, n, -dir), depth);
         }
     }
     (sky(frame, source, specular, dir), 1.0)

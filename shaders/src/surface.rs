@@ -9,7 +9,7 @@
 //! mapped by the tangent frame `(T, B = w·(N × T), N)` (§3.9.3; Mikkelsen 2008).
 
 use crate::sampling;
-use crate::shade::Material;
+use crate::shade::{Material, ShadeOptions};
 use bytemuck::{Pod, Zeroable};
 use spirv_std::glam::{Mat4, UVec4, Vec3, Vec4};
 
@@ -26,6 +26,10 @@ pub struct MeshMaterial {
     /// Which textures are present: bit 0 base colour, 1 metallic–roughness, 2 normal,
     /// 3 occlusion, 4 emissive.
     pub textures: UVec4,
+    /// Roughness clamped to `[x, y]`, metalness to `[z, w]` (a scene's declared ranges).
+    pub ranges: Vec4,
+    /// The shading models of this material.
+    pub options: ShadeOptions,
 }
 
 impl MeshMaterial {
@@ -88,8 +92,8 @@ pub fn material(m: &MeshMaterial, t: &Texels, normal: Vec3, tangent: Vec4) -> (M
     (
         Material {
             base_color: base.truncate(),
-            metallic: crate::math::saturate(metallic),
-            roughness: crate::math::saturate(roughness),
+            metallic: crate::math::clamp(metallic, m.ranges.z, m.ranges.w),
+            roughness: crate::math::clamp(roughness, m.ranges.x, m.ranges.y),
             occlusion,
             emissive,
         },

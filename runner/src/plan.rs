@@ -1,0 +1,463 @@
+//! The bake planner: from a scene, what to bake and why, what to leave out and why, at
+//! which settings, and what it will cost.
+//!
+//! Rules (each a decision printed by `runner plan`):
+//! - no material lit by the environment → nothing is baked (the sky needs only the source);
+//! - no material with specular image-based light (specular `none`, or `ibl = false`) → no
+//!   prefiltered cube and no BRDF table (unless the sky is shown blurred);
+//! - only Phong/Blinn–Phong specular → no GGX BRDF table (it belongs to Cook–Torrance);
+//! - metalness 1 everywhere → no irradiance (metals have no diffuse term);
+//! - roughness used only within `[a, b]` → only the mips whose trilinear lookups serve
+//!   `[a, b]` (the mips around `lod(a)` and `lod(b)` and those between), and those of the
+//!   sky blur;
+//! - the smallest roughness and the output resolution set the cube size: a texel need not
+//!   be finer than a pixel, nor than half the narrowest lobe (`α = r²` radians), nor than
+//!   the environment itself;
+//! - SH9 is left out: the display reads the irradiance cube;
+//! - with `[quality] max_error`, each product gets the cheapest measured setting whose mean
+//!   error meets it ([`Calibration`], from `runner report`).
+
+use crate::bake::{Products, Settings};
+use crate::scene::{MaterialSpec, Scene, SpecularArg};
+use serde::Serialize;
+use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::prefilter::RoughnessMapping;
+
+/// Error of each product against its reference, per setting, and the cost rates of each
+/// backend: what the planner chooses from. The built-in one is `runner report` on the two
+/// vendored HDRIs with a 34 000 sun and without (the worse of the two), on lavapipe and
+/// on 2 CPU cores, November 2026.
+#[derive(Clone, Debug, Serialize)]
+pub struct Calibration {
+    /// Where the numbers come from.
+    pub source: String,
+    /// BRDF table: (samples, mean absolute error).
+    pub lut: Vec<(u32, f64)>,
+    /// Prefilter at bias 0.5: (roughness, [(samples, mean relative error)]).
+    pub prefilter: Vec<(f32, Vec<(u32, f64)>)>,
+    /// Irradiance convolution: (source face size, mean relative error).
+    pub irradiance: Vec<(u32, f64)>,
+    /// Nanoseconds per unit of work on (lavapipe, CPU): equirect supersample, prefilter
+    /// sample, BRDF table sample, irradiance texel pair.
+    pub ns: [(f64, f64); 4],
+}
+
+impl Default for Calibration {
+    fn default() -> Self {
+        Self {
+            source: "built in: runner report on city.exr and courtyard.exr (the worse of the two), runner bench, lavapipe and 2 CPU cores".into(),
+            lut: vec![(16, 1.98e-2), (64, 6.62e-3), (256, 2.56e-3), (1024, 8.86e-4), (4096, 2.93e-4)],
+            prefilter: vec![
+                (1.0 / 3.0, vec![(16, 0.445), (64, 0.209), (256, 0.069), (1024, 0.0196), (4096, 0.0087)]),
+                (2.0 / 3.0, vec![(16, 0.344), (64, 0.128), (256, 0.041), (1024, 0.0162), (4096, 0.0085)]),
+                (1.0, vec![(16, 0.366), (64, 0.148), (256, 0.057), (1024, 0.0275), (4096, 0.0154)]),
+            ],
+            irradiance: vec![(4, 0.035), (8, 0.0181), (16, 0.0067), (32, 0.00168), (64, 0.00083)],
+            ns: [(139.0, 46.0), (143.0, 97.0), (3.8, 14.7), (21.7, 25.0)],
+        }
+    }
+}
+
+impl Calibration {
+    /// Reads the error model from a `report.csv` of `runner report` (its first backend),
+    /// keeping the built-in cost rates.
+    pub fn from_report_csv(text: &str) -> Option<Self> {
+        let mut c = Calibration { source: "report.csv".into(), lut: vec![], prefilter: vec![], irradiance: vec![], ..Default::default() };
+        let mut backend: Option<String> = None;
+        for line in text.lines().skip(1) {
+            let f = csv_fields(line);
+            if f.len() < 7 {
+                continue;
+            }
+            if backend.is_none() && f[3] != "NaN" {
+                backend = Some(f[1].clone());
+            }
+            if Some(&f[1]) != backend.as_ref() {
+                continue;
+            }
+            let err: f64 = f[4].parse().ok()?;
+            let first_number = |s: &str| s.split(|ch: char| !ch.is_ascii_digit()).find(|t| !t.is_empty()).and_then(|t| t.parse::<u32>().ok());
+            if f[0] == "brdf lut" {
+                c.lut.push((first_number(&f[2])?, err));
+            } else if f[0] == "irradiance (convolution)" {
+                c.irradiance.push((first_number(&f[2])?, err));
+            } else if let Some(r) = f[0].strip_prefix("prefilter r=").and_then(|r| r.parse::<f32>().ok()) {
+                let n = first_number(&f[2])?;
+                match c.prefilter.iter_mut().find(|(x, _)| (*x - r).abs() < 1e-3) {
+                    Some((_, v)) => v.push((n, err)),
+                    None => c.prefilter.push((r, vec![(n, err)])),
+                }
+            }
+        }
+        (!c.lut.is_empty() && !c.prefilter.is_empty() && !c.irradiance.is_empty()).then_some(c)
+    }
+
+    fn prefilter_error(&self, roughness: f32, samples: u32) -> f64 {
+        // The measured roughness nearest to the one asked for.
+        let table = &self
+            .prefilter
+            .iter()
+            .min_by(|a, b| (a.0 - roughness).abs().total_cmp(&(b.0 - roughness).abs()))
+            .expect("calibrated")
+            .1;
+        interpolate(table, samples)
+    }
+}
+
+/// Log–log interpolation of `(setting, error)` pairs at `x` (clamped to the table).
+fn interpolate(table: &[(u32, f64)], x: u32) -> f64 {
+    let x = x as f64;
+    if x <= table[0].0 as f64 {
+        return table[0].1;
+    }
+    for w in table.windows(2) {
+        let (x0, y0, x1, y1) = (w[0].0 as f64, w[0].1, w[1].0 as f64, w[1].1);
+        if x <= x1 {
+            let t = (x.ln() - x0.ln()) / (x1.ln() - x0.ln());
+            return (y0.ln() + t * (y1.ln() - y0.ln())).exp();
+        }
+    }
+    table[table.len() - 1].1
+}
+
+fn csv_fields(line: &str) -> Vec<String> {
+    let mut out = vec![String::new()];
+    let mut quoted = false;
+    for c in line.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            ',' if !quoted => out.push(String::new()),
+            _ => out.last_mut().expect("one field").push(c),
+        }
+    }
+    out
+}
+
+/// One decision of the plan.
+#[derive(Clone, Debug, Serialize)]
+pub struct Decision {
+    /// The product or setting.
+    pub what: String,
+    /// Baked (or chosen) rather than left out.
+    pub kept: bool,
+    /// Why.
+    pub why: String,
+}
+
+/// Estimated cost.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Cost {
+    /// Seconds on lavapipe.
+    pub gpu_seconds: f64,
+    /// Seconds on 2 CPU cores.
+    pub cpu_seconds: f64,
+    /// Bytes of the products in memory (f32 RGBA).
+    pub bytes: u64,
+}
+
+/// What to bake.
+#[derive(Clone, Debug, Serialize)]
+pub struct Plan {
+    /// Every setting.
+    pub settings: Settings,
+    /// Which products.
+    pub products: Products,
+    /// The specular mips to bake (the others stay empty: nothing reads them).
+    pub levels: Vec<u32>,
+    /// Why each product is kept or left out, and each setting chosen.
+    pub decisions: Vec<Decision>,
+    /// The plan's cost.
+    pub cost: Cost,
+    /// A full bake's cost at the same settings (every product, every mip).
+    pub full_cost: Cost,
+    /// The cost of `runner bake ENV` at its defaults (every product at 256², 1024
+    /// samples): what baking without a plan costs.
+    pub default_cost: Cost,
+}
+
+/// Mips of a specular cube of face size `size`: down to 4×4 as at the default 256² (six
+/// mips), and never fewer than six (down to 1×1 if need be), so that the roughness steps
+/// between mips stay as fine as the default's.
+pub fn mip_count(size: u32) -> u32 {
+    let chain = CubeLayout::full_chain(size);
+    chain.saturating_sub(3).max(6).min(chain)
+}
+
+/// Plans the bake of `scene` over the loaded environment `env`.
+pub fn plan_for(scene: &Scene, env: &crate::environment::Environment, cal: &Calibration) -> Plan {
+    let width = match env {
+        crate::environment::Environment::Equirect(e) => e.width,
+        crate::environment::Environment::Cube(c) => 4 * c.layout.size,
+    };
+    plan(scene, native_face_size(env), width, cal)
+}
+
+/// The environment's own resolution as a cube face size (a quarter of an equirect's width,
+/// as a power of two, at most 1024).
+pub fn native_face_size(env: &crate::environment::Environment) -> u32 {
+    match env {
+        crate::environment::Environment::Equirect(e) => (e.width / 4).max(8).next_power_of_two().min(1024),
+        crate::environment::Environment::Cube(c) => c.layout.size.min(1024),
+    }
+}
+
+/// Plans the bake of `scene` over an environment of face size `native` (see
+/// [`native_face_size`]) and equirect width `width` (for the resampling cost).
+pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
+    let mut d: Vec<Decision> = Vec::new();
+    let mut decide = |what: &str, kept: bool, why: String| d.push(Decision { what: what.into(), kept, why });
+    let used = scene.used_materials();
+    let lit: Vec<&MaterialSpec> = used.iter().copied().filter(|m| m.ibl).collect();
+    let specular_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.specular != SpecularArg::None).collect();
+    let ggx: Vec<&MaterialSpec> = specular_ibl.iter().copied().filter(|m| m.specular == SpecularArg::CookTorrance).collect();
+    let diffuse_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.metallic.range().0 < 1.0).collect();
+    let names = |v: &[&MaterialSpec]| v.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(", ");
+
+    // Cube size from the smallest roughness and the output resolution: the level that
+    // roughness reads must resolve its lobe (or a pixel, whichever is wider).
+    let r_min = specular_ibl.iter().map(|m| m.roughness.range().0).fold(1.0f32, f32::min);
+    let pixel = (scene.camera.fov.to_radians() / scene.output.height as f32) as f64;
+    let alpha = (r_min * r_min) as f64;
+    let texel = if specular_ibl.is_empty() { pixel.max(0.25) } else { pixel.max(0.5 * alpha) };
+    let defaults = Settings::default();
+    let mapping: RoughnessMapping = defaults.mapping.into();
+    let finest_read = |size: u32| -> u32 {
+        let mips = mip_count(size);
+        size >> (mapping.lod(r_min, mips).floor() as u32).min(mips - 1)
+    };
+    let mut wanted = 8u32;
+    while wanted < 4096 && std::f64::consts::FRAC_PI_2 / (finest_read(wanted) as f64) > texel {
+        wanted *= 2;
+    }
+    let size = scene.quality.size.unwrap_or(wanted.min(native));
+    let mips = mip_count(size);
+    let mut settings = Settings {
+        size,
+        source_size: native.max(size),
+        mips,
+        irradiance_source: defaults.irradiance_source.min(native.max(size)),
+        sh_source: defaults.sh_source.min(native.max(size)),
+        ..defaults
+    };
+    if !specular_ibl.is_empty() {
+        let why = if scene.quality.size.is_some() {
+            "as [quality] size asks".to_string()
+        } else {
+            let level = (mapping.lod(r_min, mips).floor() as u32).min(mips - 1);
+            format!(
+                "the smallest roughness {r_min} reads mip {level} ({0}², texel {1:.4} rad), which must resolve half its lobe (α = {alpha:.4} rad) or a pixel of {2}×{3} at {4}° ({pixel:.4} rad); the environment has {native}²",
+                size >> level,
+                std::f64::consts::FRAC_PI_2 / (size >> level) as f64,
+                scene.output.width,
+                scene.output.height,
+                scene.camera.fov,
+            )
+        };
+        decide("cube size", true, format!("{size}×{size} × {mips} mips: {why}"));
+    }
+
+    // Quality: explicit settings, else the cheapest measured ones meeting max_error.
+    let q = &scene.quality;
+    let target = q.max_error;
+    let pick = |table: &[(u32, f64)], target: f64| -> (u32, f64, bool) {
+        match table.iter().find(|(_, e)| *e <= target) {
+            Some(&(s, e)) => (s, e, true),
+            None => {
+                let &(s, e) = table.last().expect("calibrated");
+                (s, e, false)
+            }
+        }
+    };
+    let roughness_of = |m: u32| mapping.roughness(m, mips);
+    let lod_of = |r: f32| mapping.lod(r, mips);
+
+    // Specular mips.
+    let mut levels: Vec<u32> = Vec::new();
+    let add_range = |lo: f32, hi: f32, levels: &mut Vec<u32>| {
+        let a = lod_of(lo).floor() as u32;
+        let b = (lod_of(hi).ceil() as u32).min(mips - 1);
+        for l in a..=b {
+            if !levels.contains(&l) {
+                levels.push(l);
+            }
+        }
+    };
+    for m in &specular_ibl {
+        let (a, b) = m.roughness.range();
+        add_range(a, b, &mut levels);
+    }
+    if scene.sky_blur > 0.0 {
+        let b = scene.sky_blur.min((mips - 1) as f32);
+        let (lo, hi) = (b.floor() as u32, (b.ceil() as u32).min(mips - 1));
+        for l in lo..=hi {
+            if !levels.contains(&l) {
+                levels.push(l);
+            }
+        }
+    }
+    levels.sort();
+
+    let specular = !levels.is_empty();
+    if lit.is_empty() {
+        decide("everything", false, "no material is lit by the environment (all have ibl = false, or no objects): the sky needs only the source cube".into());
+    }
+    if specular {
+        let why = if specular_ibl.is_empty() {
+            format!("only for the sky's blur {}", scene.sky_blur)
+        } else {
+            let lo = specular_ibl.iter().map(|m| m.roughness.range().0).fold(1.0f32, f32::min);
+            let hi = specular_ibl.iter().map(|m| m.roughness.range().1).fold(0.0f32, f32::max);
+            format!("specular image-based light of {} (roughness {lo}–{hi})", names(&specular_ibl))
+        };
+        decide("prefiltered specular cube", true, why);
+        let all: Vec<u32> = (0..mips).collect();
+        let skipped: Vec<String> = all.iter().filter(|l| !levels.contains(l)).map(|&l| format!("{l} (r={:.2})", roughness_of(l))).collect();
+        let kept: Vec<String> = levels.iter().map(|&l| format!("{l} (r={:.2})", roughness_of(l))).collect();
+        decide("specular mips", true, format!("baked: {}", kept.join(", ")));
+        if !skipped.is_empty() {
+            decide("specular mips", false, format!("{}: no material roughness or sky blur reads them", skipped.join(", ")));
+        }
+    } else if !lit.is_empty() {
+        decide("prefiltered specular cube", false, "no material has specular image-based light (specular = none or ibl = false) and the sky is sharp".into());
+    }
+    let lut = !ggx.is_empty();
+    if lut {
+        decide("BRDF table", true, format!("Cook–Torrance image-based light of {}", names(&ggx)));
+    } else if !specular_ibl.is_empty() {
+        decide("BRDF table", false, "only Phong/Blinn–Phong specular: the GGX table does not apply to them".into());
+    } else if !lit.is_empty() {
+        decide("BRDF table", false, "no specular image-based light".into());
+    }
+    let irradiance = !diffuse_ibl.is_empty();
+    if irradiance {
+        decide("irradiance cube", true, format!("diffuse image-based light of {}", names(&diffuse_ibl)));
+    } else if !lit.is_empty() {
+        decide("irradiance cube", false, "every lit material is metal (metallic = 1): no diffuse term".into());
+    }
+    if !lit.is_empty() {
+        decide("SH9", false, "the display reads the irradiance cube; SH9 is for `runner bake ENV`".into());
+    }
+
+    // Samples, bias, table, irradiance source.
+    settings.lod_bias = q.lod_bias.unwrap_or(settings.lod_bias);
+    let needed_r: Vec<f32> = levels.iter().map(|&l| roughness_of(l)).filter(|&r| r > 0.0).collect();
+    settings.samples = match (q.samples, target) {
+        (Some(n), _) => n,
+        (None, Some(e)) if specular => {
+            let table: Vec<(u32, f64)> = cal.prefilter[0]
+                .1
+                .iter()
+                .map(|&(n, _)| (n, needed_r.iter().map(|&r| cal.prefilter_error(r, n)).fold(0.0, f64::max)))
+                .collect();
+            let (n, err, ok) = pick(&table, e);
+            decide(
+                "prefilter samples",
+                true,
+                if ok { format!("{n}: the cheapest measured count with mean error {err:.2e} ≤ {e}") } else { format!("{n}: the largest measured; its error {err:.2e} is still above {e}") },
+            );
+            n
+        }
+        _ => settings.samples,
+    };
+    settings.lut_samples = match (q.lut_samples, target) {
+        (Some(n), _) => n,
+        (None, Some(e)) if lut => {
+            let (n, err, ok) = pick(&cal.lut, e);
+            decide(
+                "BRDF table samples",
+                true,
+                if ok { format!("{n}: the cheapest measured count with mean error {err:.2e} ≤ {e}") } else { format!("{n}: the largest measured; error {err:.2e} > {e}") },
+            );
+            n
+        }
+        _ => settings.lut_samples,
+    };
+    settings.lut_size = q.lut_size.unwrap_or(settings.lut_size);
+    settings.irradiance_source = match (q.irradiance_source, target) {
+        (Some(s), _) => s,
+        (None, Some(e)) if irradiance => {
+            let (s, err, ok) = pick(&cal.irradiance, e);
+            let s = s.min(settings.source_size);
+            decide(
+                "irradiance source level",
+                true,
+                if ok { format!("{s}×{s}: the cheapest measured level with mean error {err:.2e} ≤ {e}") } else { format!("{s}×{s}: the finest measured; error {err:.2e} > {e}") },
+            );
+            s
+        }
+        _ => settings.irradiance_source,
+    };
+
+    let products = Products { specular, irradiance, sh9: false, lut };
+    let cost = estimate(&settings, products, &levels, width, cal);
+    let all_levels: Vec<u32> = (0..mips).collect();
+    let full_cost = estimate(&settings, Products::ALL, &all_levels, width, cal);
+    let default_settings = Settings::default();
+    let default_levels: Vec<u32> = (0..default_settings.mips).collect();
+    let default_cost = estimate(&default_settings, Products::ALL, &default_levels, width, cal);
+    Plan { settings, products, levels, decisions: d, cost, full_cost, default_cost }
+}
+
+/// Estimated time and memory of baking `products` (and `levels` of the specular cube).
+pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration) -> Cost {
+    let mut work = [0.0f64; 4];
+    let mut bytes = 0u64;
+    let n = splitsum_shaders::equirect::supersampling(s.source_size, width.max(1), s.supersample_density) as f64;
+    let source = CubeLayout::new(s.source_size, CubeLayout::full_chain(s.source_size));
+    work[0] = 6.0 * (s.source_size as f64).powi(2) * n * n;
+    bytes += source.texel_count() as u64 * 16;
+    if products.specular {
+        let out = s.specular_layout();
+        let mapping: RoughnessMapping = s.mapping.into();
+        for &l in levels {
+            let texels = 6.0 * (out.level_size(l) as f64).powi(2);
+            if mapping.roughness(l, s.mips) > 0.0 {
+                work[1] += texels * s.samples as f64;
+            }
+            bytes += texels as u64 * 16;
+        }
+    }
+    if products.lut {
+        work[2] = (s.lut_size as f64).powi(2) * s.lut_samples as f64;
+        bytes += (s.lut_size as u64).pow(2) * 8;
+    }
+    if products.irradiance {
+        work[3] = 6.0 * (s.irradiance_size as f64).powi(2) * 6.0 * (s.irradiance_source as f64).powi(2);
+        bytes += 6 * (s.irradiance_size as u64).pow(2) * 16;
+    }
+    let secs = |k: usize| -> (f64, f64) { (work[k] * cal.ns[k].0 * 1e-9, work[k] * cal.ns[k].1 * 1e-9) };
+    let total = (0..4).map(secs).fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+    Cost { gpu_seconds: total.0, cpu_seconds: total.1, bytes }
+}
+
+/// The plan as text, for `runner plan`.
+pub fn describe(plan: &Plan, scene: &str, environment: &str) -> String {
+    use std::fmt::Write as _;
+    let mut out = String::new();
+    let _ = writeln!(out, "plan for {scene} (environment: {environment})");
+    for d in plan.decisions.iter().filter(|d| d.kept) {
+        let _ = writeln!(out, "  bake   {:<26} {}", d.what, d.why);
+    }
+    for d in plan.decisions.iter().filter(|d| !d.kept) {
+        let _ = writeln!(out, "  skip   {:<26} {}", d.what, d.why);
+    }
+    let s = &plan.settings;
+    let p = plan.products;
+    let mut kept = vec![format!("source {}²", s.source_size)];
+    if p.specular {
+        kept.push(format!("specular {}² × {} mips ({:?}), {} samples, bias {}", s.size, s.mips, s.mapping, s.samples, s.lod_bias));
+    }
+    if p.lut {
+        kept.push(format!("table {}² × {} samples", s.lut_size, s.lut_samples));
+    }
+    if p.irradiance {
+        kept.push(format!("irradiance {}² from {}²", s.irradiance_size, s.irradiance_source));
+    }
+    let _ = writeln!(out, "  settings: {}", kept.join("; "));
+    let mib = |c: Cost| c.bytes as f64 / 1048576.0;
+    let line = |c: Cost| format!("{:.2} s on lavapipe, {:.2} s on 2 CPU cores, {:.1} MiB", c.gpu_seconds, c.cpu_seconds, mib(c));
+    let _ = writeln!(out, "  estimate: {}", line(plan.cost));
+    let _ = writeln!(out, "            every product and mip at these settings: {}", line(plan.full_cost));
+    let _ = writeln!(out, "            `runner bake ENV` at its defaults:        {}", line(plan.default_cost));
+    out
+}

@@ -1,0 +1,388 @@
+//! Scene files, the bake planner and the cache: each rule leaves out exactly what it should,
+//! a render from the reduced bake equals the render from a full bake, unchanged bakes come
+//! from the cache, and corrupt or foreign entries are rebuilt, never used.
+
+use runner::Backend;
+use runner::bake::{self, Outcome, Products};
+use runner::cache::{Cache, Lookup};
+use runner::environment::Environment;
+use runner::plan::{self, Calibration, Plan};
+use runner::render::BakedEnvironment;
+use runner::scene::Scene;
+use splitsum_shaders::glam::Vec4;
+use splitsum_shaders::scene::Frame;
+use std::path::{Path, PathBuf};
+
+fn assets() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets")
+}
+
+/// A scene over the vendored courtyard, with `body` (materials, objects, quality …) after
+/// the top-level keys in `head`.
+fn scene(head: &str, body: &str) -> Scene {
+    let env = assets().join("environments/courtyard.exr");
+    let text = format!("environment = {:?}\n{head}\n{body}", env.display().to_string());
+    Scene::parse(&text).unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+fn material(name: &str, fields: &str) -> String {
+    format!("[[materials]]\nname = {name:?}\n{fields}\n\n[[objects]]\nkind = \"sphere-grid\"\nmaterial = {name:?}\n")
+}
+
+/// The plan over a 256² environment of width 1024 (the vendored ones).
+fn planned(s: &Scene) -> Plan {
+    plan::plan(s, 256, 1024, &Calibration::default())
+}
+
+fn skipped(p: &Plan, what: &str) -> bool {
+    p.decisions.iter().any(|d| !d.kept && d.what == what)
+}
+
+#[test]
+fn a_full_scene_keeps_everything() {
+    let p = planned(&scene("", &material("all", "metallic = [0.0, 1.0]\nroughness = [0.0, 1.0]")));
+    assert_eq!((p.products.specular, p.products.lut, p.products.irradiance), (true, true, true));
+    assert_eq!(p.levels, (0..p.settings.mips).collect::<Vec<_>>());
+    assert_eq!(p.settings.size, 256, "roughness 0 needs the environment's full resolution");
+    assert!(!p.products.sh9, "the display reads the irradiance cube, not SH9");
+    assert!((p.cost.cpu_seconds - p.full_cost.cpu_seconds).abs() < 1e-9);
+}
+
+#[test]
+fn no_specular_image_light_drops_the_prefilter_and_the_table() {
+    for fields in ["specular = \"none\"", "specular = \"none\"\ndiffuse = \"oren-nayar\""] {
+        let p = planned(&scene("", &material("clay", fields)));
+        assert!(!p.products.specular && !p.products.lut && p.products.irradiance, "{fields}: {p:?}");
+        assert!(p.levels.is_empty());
+        assert!(skipped(&p, "prefiltered specular cube") && skipped(&p, "BRDF table"));
+        assert!(p.cost.cpu_seconds < p.full_cost.cpu_seconds);
+    }
+}
+
+#[test]
+fn a_blurred_sky_keeps_only_the_mips_it_reads() {
+    let p = planned(&scene("sky_blur = 2.5", &material("clay", "specular = \"none\"")));
+    assert!(p.products.specular && !p.products.lut);
+    assert_eq!(p.levels, vec![2, 3]);
+}
+
+#[test]
+fn only_metals_drop_the_irradiance() {
+    let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.0, 1.0]")));
+    assert!(p.products.specular && p.products.lut && !p.products.irradiance);
+    assert!(skipped(&p, "irradiance cube"));
+    // A metalness range that reaches below 1 needs it again.
+    let p = planned(&scene("", &material("alloy", "metallic = [0.9, 1.0]")));
+    assert!(p.products.irradiance);
+}
+
+#[test]
+fn a_roughness_range_keeps_the_mips_around_it() {
+    // Six mips at roughness m/5 (the 128² cube this range asks for): r ∈ [0.4, 0.7] reads
+    // lod 2 … 3.5, so mips 2, 3 and 4 (trilinear filtering's upper neighbour).
+    let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
+    assert_eq!(p.settings.mips, 6);
+    assert_eq!(p.levels, vec![2, 3, 4]);
+    assert!(skipped(&p, "specular mips"));
+    // A single roughness on a mip's own value needs only that mip.
+    let p = planned(&scene("", &material("satin", "roughness = 0.6")));
+    assert_eq!(p.levels, vec![3]);
+    // Two materials: the union of their mips.
+    let two = format!("{}{}", material("a", "roughness = 0.2"), material("b", "roughness = [0.85, 0.9]"));
+    assert_eq!(planned(&scene("", &two)).levels, vec![1, 4, 5]);
+}
+
+#[test]
+fn phong_and_blinn_phong_need_no_ggx_table() {
+    for model in ["phong", "blinn-phong"] {
+        let p = planned(&scene("", &material("plastic", &format!("specular = {model:?}\nroughness = [0.2, 0.6]"))));
+        assert!(p.products.specular && p.products.irradiance && !p.products.lut, "{model}");
+        assert!(skipped(&p, "BRDF table"));
+    }
+    // One Cook–Torrance material among them brings it back.
+    let two = format!("{}{}", material("a", "specular = \"phong\""), material("b", "specular = \"cook-torrance\""));
+    assert!(planned(&scene("", &two)).products.lut);
+}
+
+#[test]
+fn no_image_light_bakes_nothing() {
+    for body in [material("unlit", "ibl = false"), String::new()] {
+        let p = planned(&scene("", &body));
+        assert!(!p.products.specular && !p.products.lut && !p.products.irradiance && !p.products.sh9);
+        assert!(p.levels.is_empty());
+        assert!(skipped(&p, "everything"));
+    }
+}
+
+#[test]
+fn the_smallest_roughness_and_the_output_set_the_cube_size() {
+    // Roughness ≥ 0.4 reads mip 2 at the finest; half its lobe (α/2 = 0.08 rad) needs a
+    // texel of at most 0.08 rad there: π/2 / 32 = 0.049 (a 128² cube), not π/2 / 16 = 0.098.
+    let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
+    assert_eq!(p.settings.size, 128);
+    // Rougher still: r ≥ 0.8 reads mip 4 (lod 5r), half its lobe is 0.32 rad: mip 4 of a
+    // 64² cube is 4² (texel 0.39 rad, too coarse), of a 128² cube 8² (0.196 rad).
+    let p = planned(&scene("", &material("rough", "roughness = [0.8, 1.0]")));
+    assert_eq!(p.settings.size, 128);
+    // A mirror needs a pixel's resolution, capped by the environment's own.
+    let mirror = material("mirror", "metallic = 1.0\nroughness = 0.0");
+    assert_eq!(planned(&scene("", &mirror)).settings.size, 256);
+    assert_eq!(plan::plan(&scene("", &mirror), 64, 256, &Calibration::default()).settings.size, 64);
+    // A tiny output: 30 pixels over 45° are 0.026 rad each; mip 0 of a 64² cube has
+    // texels of 0.0245 rad, of a 32² cube 0.049 rad.
+    let tiny = scene("[output]\nwidth = 30\nheight = 30", &mirror);
+    assert_eq!(planned(&tiny).settings.size, 64);
+    // [quality] size overrides.
+    assert_eq!(planned(&scene("", &format!("{mirror}\n[quality]\nsize = 32"))).settings.size, 32);
+}
+
+#[test]
+fn a_maximum_error_picks_the_cheapest_settings_that_meet_it() {
+    let body = material("plastic", "roughness = [0.3, 1.0]");
+    let loose = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.05")));
+    let tight = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.002")));
+    // Loose, from the built-in table: mips 1 … 5 (r = 0.2 … 1) need ≤ 0.05 at r = ⅓, ⅔
+    // and 1: 256 samples give 0.069 at ⅓, 1024 give at most 0.0275. The table: 16 samples
+    // (0.0198). The irradiance: the 4² level (0.035).
+    assert_eq!((loose.settings.samples, loose.settings.lut_samples, loose.settings.irradiance_source), (1024, 16, 4));
+    // Tight: no measured count reaches 0.002 at r = 1 (4096 give 0.0154), and the plan
+    // says so; the table needs 1024 (8.9e-4; 256 give 2.6e-3); the irradiance 32² (1.7e-3).
+    assert_eq!((tight.settings.samples, tight.settings.lut_samples, tight.settings.irradiance_source), (4096, 1024, 32));
+    assert!(tight.decisions.iter().any(|d| d.what == "prefilter samples" && d.why.contains("still above")));
+    assert!(tight.cost.cpu_seconds > 2.0 * loose.cost.cpu_seconds);
+    // Fixed settings are kept as given.
+    let fixed = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.05\nsamples = 77")));
+    assert_eq!(fixed.settings.samples, 77);
+}
+
+#[test]
+fn the_calibration_reads_a_report() {
+    let dir = temp("calibration");
+    let env = assets().join("environments/studio.exr");
+    runner::cli::run(["runner", "report", env.to_str().unwrap(), "--quick", "--backends", "cpu", "--out", dir.to_str().unwrap()]).expect("report");
+    let cal = Calibration::from_report_csv(&std::fs::read_to_string(dir.join("report.csv")).unwrap()).expect("a calibration");
+    assert_eq!(cal.lut.iter().map(|r| r.0).collect::<Vec<_>>(), vec![4, 16, 64]);
+    assert!(!cal.prefilter.is_empty() && cal.irradiance.len() == 3);
+    assert!(cal.lut.iter().all(|r| r.1.is_finite() && r.1 > 0.0));
+    assert!(Calibration::from_report_csv("product,backend\nnothing,here\n").is_none());
+}
+
+// --- Reduced bake against full bake -------------------------------------------------------
+
+/// Small, fast settings for the equality tests.
+const QUICK: &str = "[quality]\nsize = 32\nsamples = 32\nlut_size = 16\nlut_samples = 32\nirradiance_source = 8";
+
+fn environment() -> Environment {
+    runner::environment::load(&assets().join("environments/courtyard.exr"), false).unwrap().0
+}
+
+/// The plan's bake and the full bake at the same settings (every product, every mip).
+fn reduced_and_full(s: &Scene, env: &Environment) -> (Plan, BakedEnvironment, BakedEnvironment) {
+    let p = plan::plan_for(s, env, &Calibration::default());
+    let (reduced, _) = bake::bake_plan(&Backend::Cpu, env, &p).unwrap();
+    let mut all = p.clone();
+    all.products = Products::ALL;
+    all.levels = (0..p.settings.mips).collect();
+    let (full, _) = bake::bake_plan(&Backend::Cpu, env, &all).unwrap();
+    (p, reduced, full)
+}
+
+fn render(s: &Scene, env: &BakedEnvironment, backend: &Backend) -> Vec<Vec4> {
+    let view = s.view(env.auto_exposure());
+    let mut frame = view.frame(env.shape(), 96, 54, true);
+    frame.flags.x |= Frame::LINEAR;
+    let model = s.model().unwrap();
+    match (backend, &model) {
+        (Backend::Cpu, Some(m)) => runner::raster::render(env, &frame, m),
+        (Backend::Cpu, None) => runner::render::render_cpu(env, &frame),
+        (Backend::Gpu(g), m) => {
+            let scene = runner::render::GpuScene::new(g, env);
+            let gm = m.as_ref().map(|m| runner::render::GpuModel::new(g, &scene, m));
+            scene.render_offscreen(g, &frame, gm.as_ref()).unwrap()
+        }
+    }
+}
+
+fn max_abs(a: &[Vec4], b: &[Vec4]) -> f32 {
+    assert_eq!(a.len(), b.len());
+    a.iter().zip(b).map(|(x, y)| (*x - *y).abs().max_element()).fold(0.0, f32::max)
+}
+
+#[test]
+fn renders_from_reduced_bakes_equal_renders_from_full_bakes() {
+    let env = environment();
+    let torus = assets().join("models/torus.glb");
+    let cases = [
+        ("metals", String::new(), material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]\nbase_color = [0.9, 0.9, 0.9]")),
+        ("clay", String::new(), material("clay", "specular = \"none\"\ndiffuse = \"oren-nayar\"\nroughness = 0.8")),
+        ("phong", String::new(), material("plastic", "specular = \"blinn-phong\"\nroughness = [0.2, 0.6]")),
+        ("blurred sky", "sky_blur = 1.5".to_string(), material("clay", "specular = \"none\"")),
+        (
+            "textured model",
+            String::new(),
+            format!(
+                "{}\n[[objects]]\nkind = \"gltf\"\npath = {:?}\nmaterial = \"torus\"\n[[materials]]\nname = \"torus\"\nmetallic = \"texture\"\nroughness = [0.5, 0.9]\n",
+                material("steel", "metallic = 1.0\nroughness = [0.5, 0.9]"),
+                torus.display().to_string()
+            ),
+        ),
+    ];
+    let gpu = support::gpu();
+    for (name, head, body) in cases {
+        let s = scene(&head, &format!("{body}\n{QUICK}\n[[lights]]\nkind = \"directional\"\ndirection = [0.3, 1.0, 0.5]\nradiance = [2.0, 2.0, 2.0]"));
+        let (p, reduced, full) = reduced_and_full(&s, &env);
+        let left_out = !(p.products.specular && p.products.lut && p.products.irradiance) || p.levels.len() < p.settings.mips as usize;
+        assert!(left_out, "{name}: the plan should leave something out");
+        let cpu = max_abs(&render(&s, &reduced, &Backend::Cpu), &render(&s, &full, &Backend::Cpu));
+        let lava = max_abs(&render(&s, &reduced, gpu), &render(&s, &full, gpu));
+        println!("{name}: levels {:?} of {}, products {:?}: reduced vs full, CPU {cpu:e}, GPU {lava:e}", p.levels, p.settings.mips, p.products);
+        assert_eq!(cpu, 0.0, "{name}: the reduced bake changed the CPU render");
+        assert!(lava <= 1e-6, "{name}: the reduced bake changed the GPU render by {lava}");
+    }
+}
+
+// --- The cache ----------------------------------------------------------------------------
+
+fn temp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("splitsum-plan-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+fn same(a: &BakedEnvironment, b: &BakedEnvironment) -> bool {
+    a.source.texels == b.source.texels && a.specular.texels == b.specular.texels && a.irradiance.texels == b.irradiance.texels && a.lut.texels == b.lut.texels
+}
+
+fn entry_file(dir: &Path, key: &str, name: &str) -> PathBuf {
+    dir.join(key).join(name)
+}
+
+#[test]
+fn the_cache_reuses_unchanged_bakes_and_rebuilds_bad_entries() {
+    let dir = temp("cache");
+    let cache = Cache::new(&dir);
+    let cal = Calibration::default();
+    let s = scene("", &format!("{}\n{QUICK}", material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
+    let first = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap();
+    assert_eq!(first.outcome, Outcome::Baked);
+    assert!(!first.timings.is_empty());
+    let second = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap();
+    assert_eq!(second.outcome, Outcome::CacheHit);
+    assert!(second.timings.is_empty() && second.key == first.key && same(&first.env, &second.env));
+    // --force bakes again.
+    assert_eq!(bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), true).unwrap().outcome, Outcome::Forced);
+
+    // Any parameter changes the key: a sample count, the roughness range, the backend.
+    let more = scene("", &format!("{}\n{}", material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]"), QUICK.replace("samples = 32\nlut", "samples = 33\nlut")));
+    let other = bake::bake_scene(&Backend::Cpu, &more, &cal, Some(&cache), false).unwrap();
+    assert_eq!(other.outcome, Outcome::Baked);
+    assert_ne!(other.key, first.key);
+    let k = |env: &[u8], plan: &str, backend: &str| runner::cache::key(env, plan, backend);
+    assert_ne!(k(b"abc", "{}", "cpu"), k(b"abd", "{}", "cpu"), "a byte of the input");
+    assert_ne!(k(b"abc", "{}", "cpu"), k(b"abc", "{}", "gpu"), "the backend");
+    assert_ne!(k(b"ab", "c{}", "cpu"), k(b"abc", "{}", "cpu"), "the parts are length-delimited");
+
+    // A corrupt entry: one flipped byte in a product.
+    let spec = entry_file(&dir, &first.key, "specular.bin");
+    let mut bytes = std::fs::read(&spec).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0x40;
+    std::fs::write(&spec, &bytes).unwrap();
+    match cache.get(&first.key) {
+        Lookup::Rejected(why) => assert!(why.contains("corrupt"), "{why}"),
+        _ => panic!("a corrupt entry must be rejected"),
+    }
+    assert_eq!(bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap().outcome, Outcome::Baked, "a rejected entry is removed");
+    // A truncated product, found by the bake itself.
+    let lut = entry_file(&dir, &first.key, "lut.bin");
+    let mut bytes = std::fs::read(&lut).unwrap();
+    bytes.truncate(bytes.len() - 3);
+    std::fs::write(&lut, &bytes).unwrap();
+    let rebuilt = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap();
+    assert!(matches!(&rebuilt.outcome, Outcome::Rebuilt(why) if why.contains("lut.bin")), "{:?}", rebuilt.outcome);
+    assert!(same(&rebuilt.env, &first.env), "the rebuilt bake is the bake");
+    assert_eq!(bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap().outcome, Outcome::CacheHit);
+
+    // A foreign entry: another bake's folder under this key.
+    let _ = std::fs::remove_dir_all(dir.join(&first.key));
+    copy_dir(&dir.join(&other.key), &dir.join(&first.key));
+    let r = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap();
+    assert!(matches!(&r.outcome, Outcome::Rebuilt(why) if why.contains("foreign")), "{:?}", r.outcome);
+    assert!(same(&r.env, &first.env));
+
+    // A manifest that is not JSON, and an entry with no manifest.
+    std::fs::write(entry_file(&dir, &first.key, "manifest.json"), "{ not json").unwrap();
+    assert!(matches!(cache.get(&first.key), Lookup::Rejected(why) if why.contains("malformed")));
+    std::fs::create_dir_all(dir.join(&first.key)).unwrap();
+    assert!(matches!(cache.get(&first.key), Lookup::Rejected(why) if why.contains("manifest")));
+    assert!(matches!(cache.get(&first.key), Lookup::Miss), "a rejected entry is removed");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+}
+
+// --- Scene files and the command line -------------------------------------------------------
+
+fn load_error(text: &str) -> String {
+    let dir = temp("scene-errors");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, text).unwrap();
+    let e = Scene::load(&path).expect_err(text).to_string();
+    assert!(e.contains("bad.toml"), "the error must name the file: {e}");
+    e
+}
+
+#[test]
+fn scene_errors_name_the_file_and_the_problem() {
+    assert!(load_error("[output]\nwidth = 64\nheigth = 64\n").contains("heigth"));
+    let e = load_error("[[materials]]\nname = \"a\"\nroughness = 0.5\nroughness = 0.6\n");
+    assert!(e.contains("line 4"), "{e}");
+    assert!(load_error("[[objects]]\nkind = \"sphere-grid\"\nmaterial = \"gold\"\n").contains("\"gold\""));
+    assert!(load_error("[[materials]]\nname = \"a\"\nroughness = [0.7, 0.2]\n").contains("roughness range"));
+    assert!(load_error("[[materials]]\nname = \"a\"\nmetallic = \"wood\"\n").contains("metallic"));
+    assert!(load_error("[[materials]]\nname = \"a\"\nspecular = \"ward\"\n").contains("ward"));
+    assert!(load_error("[quality]\nmax_error = -1.0\n").contains("max_error"));
+    assert!(load_error("[[objects]]\nkind = \"teapot\"\n").contains("teapot"));
+    let missing = std::env::temp_dir().join("splitsum-no-such-scene.toml");
+    assert!(Scene::load(&missing).unwrap_err().to_string().contains("splitsum-no-such-scene.toml"));
+}
+
+#[test]
+fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
+    let scenes = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes");
+    for name in ["showroom", "brushed-metal", "matte-clay", "retro-phong", "unlit"] {
+        let path = scenes.join(format!("{name}.toml"));
+        runner::cli::run(["runner", "plan", path.to_str().unwrap()]).unwrap_or_else(|e| panic!("{name}: {e:#}"));
+    }
+    // bake --scene twice: the second is a cache hit and rewrites the same files.
+    let dir = temp("scene-bake");
+    let cache = dir.join("cache");
+    let out = dir.join("out");
+    let file = dir.join("small.toml");
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(&file, format!("{}\n{QUICK}", material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]"))).unwrap();
+    let args = ["runner", "bake", "--scene", file.to_str().unwrap(), "--backend", "cpu", "--cache", cache.to_str().unwrap(), "--out", out.to_str().unwrap()];
+    runner::cli::run(args).expect("first bake");
+    let plan_json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
+    assert_eq!(plan_json["plan"]["products"]["irradiance"], false);
+    assert!(out.join("specular.ktx2").exists() && out.join("brdf_lut.exr").exists());
+    assert!(!out.join("irradiance.ktx2").exists(), "left-out products are not written");
+    // specular.ktx2 holds mips 2 … 4 of the 32² cube: an 8² cube with three mips.
+    let ktx = std::fs::read(out.join("specular.ktx2")).unwrap();
+    let reader = ktx2::Reader::new(&ktx[..]).expect("a KTX2 file");
+    let h = reader.header();
+    assert_eq!((h.pixel_width, h.face_count, h.level_count), (8, 6, 3));
+    let r: Vec<f64> = plan_json["specular_roughness_per_mip"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    assert!(r.iter().zip([0.4, 0.6, 0.8]).all(|(a, b)| (a - b).abs() < 1e-6), "{r:?}");
+    let entries = std::fs::read_dir(&cache).unwrap().count();
+    runner::cli::run(args).expect("second bake");
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), entries, "no new cache entry");
+    let _ = std::fs::remove_dir_all(&dir);
+}
