@@ -10,7 +10,7 @@ fn quick_report_writes_tables_csv_and_plot() {
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     let png = image::open(dir.join("error_vs_time.png")).expect("a PNG").to_rgb8();
     assert!(png.width() > 500 && png.height() > 300);
-    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(fields).collect();
+    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(runner::report::csv_fields).collect();
     for product in ["brdf lut", "prefilter r=0.33", "irradiance (convolution)", "irradiance (SH9)", "shaded colour (n.v >= 0.6)"] {
         for backend in ["gpu", "cpu"] {
             assert!(rows.iter().any(|r| r[0] == product && r[1].starts_with(backend)), "no {product} on {backend}");
@@ -28,18 +28,4 @@ fn quick_report_writes_tables_csv_and_plot() {
         assert!(errs.first() > errs.last(), "{backend}: {errs:?}");
     }
     assert!(md.contains("Best error per millisecond"));
-}
-
-/// The fields of a CSV line (double-quoted fields may hold commas).
-fn fields(line: &str) -> Vec<String> {
-    let mut out = vec![String::new()];
-    let mut quoted = false;
-    for c in line.chars() {
-        match c {
-            '"' => quoted = !quoted,
-            ',' if !quoted => out.push(String::new()),
-            _ => out.last_mut().unwrap().push(c),
-        }
-    }
-    out
 }

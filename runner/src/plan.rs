@@ -65,7 +65,7 @@ impl Calibration {
         let mut c = Calibration { source: "report.csv".into(), lut: vec![], prefilter: vec![], irradiance: vec![], ..Default::default() };
         let mut backend: Option<String> = None;
         for line in text.lines().skip(1) {
-            let f = csv_fields(line);
+            let f = crate::report::csv_fields(line);
             if f.len() < 7 {
                 continue;
             }
@@ -118,19 +118,6 @@ fn interpolate(table: &[(u32, f64)], x: u32) -> f64 {
         }
     }
     table[table.len() - 1].1
-}
-
-fn csv_fields(line: &str) -> Vec<String> {
-    let mut out = vec![String::new()];
-    let mut quoted = false;
-    for c in line.chars() {
-        match c {
-            '"' => quoted = !quoted,
-            ',' if !quoted => out.push(String::new()),
-            _ => out.last_mut().expect("one field").push(c),
-        }
-    }
-    out
 }
 
 /// One decision of the plan.
@@ -259,15 +246,6 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     // Quality: explicit settings, else the cheapest measured ones meeting max_error.
     let q = &scene.quality;
     let target = q.max_error;
-    let pick = |table: &[(u32, f64)], target: f64| -> (u32, f64, bool) {
-        match table.iter().find(|(_, e)| *e <= target) {
-            Some(&(s, e)) => (s, e, true),
-            None => {
-                let &(s, e) = table.last().expect("calibrated");
-                (s, e, false)
-            }
-        }
-    };
     let roughness_of = |m: u32| mapping.roughness(m, mips);
     let lod_of = |r: f32| mapping.lod(r, mips);
 
@@ -349,12 +327,8 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
                 .iter()
                 .map(|&(n, _)| (n, needed_r.iter().map(|&r| cal.prefilter_error(r, n)).fold(0.0, f64::max)))
                 .collect();
-            let (n, err, ok) = pick(&table, e);
-            decide(
-                "prefilter samples",
-                true,
-                if ok { format!("{n}: the cheapest measured count with mean error {err:.2e} ≤ {e}") } else { format!("{n}: the largest measured; its error {err:.2e} is still above {e}") },
-            );
+            let (n, why) = cheapest(&table, e, |n| n.to_string());
+            decide("prefilter samples", true, why);
             n
         }
         _ => settings.samples,
@@ -362,12 +336,8 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     settings.lut_samples = match (q.lut_samples, target) {
         (Some(n), _) => n,
         (None, Some(e)) if lut => {
-            let (n, err, ok) = pick(&cal.lut, e);
-            decide(
-                "BRDF table samples",
-                true,
-                if ok { format!("{n}: the cheapest measured count with mean error {err:.2e} ≤ {e}") } else { format!("{n}: the largest measured; error {err:.2e} > {e}") },
-            );
+            let (n, why) = cheapest(&cal.lut, e, |n| n.to_string());
+            decide("BRDF table samples", true, why);
             n
         }
         _ => settings.lut_samples,
@@ -376,13 +346,10 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     settings.irradiance_source = match (q.irradiance_source, target) {
         (Some(s), _) => s,
         (None, Some(e)) if irradiance => {
-            let (s, err, ok) = pick(&cal.irradiance, e);
-            let s = s.min(settings.source_size);
-            decide(
-                "irradiance source level",
-                true,
-                if ok { format!("{s}×{s}: the cheapest measured level with mean error {err:.2e} ≤ {e}") } else { format!("{s}×{s}: the finest measured; error {err:.2e} > {e}") },
-            );
+            // Only the levels the source cube has.
+            let sources: Vec<(u32, f64)> = cal.irradiance.iter().copied().filter(|&(s, _)| s <= settings.source_size).collect();
+            let (s, why) = cheapest(&sources, e, |s| format!("{s}×{s} source level"));
+            decide("irradiance source", true, why);
             s
         }
         _ => settings.irradiance_source,
@@ -396,6 +363,18 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     let default_levels: Vec<u32> = (0..default_settings.mips).collect();
     let default_cost = estimate(&default_settings, Products::ALL, &default_levels, width, cal);
     Plan { settings, products, levels, decisions: d, cost, full_cost, default_cost }
+}
+
+/// The first (cheapest) setting of `table` whose error meets `target`, else the last (the
+/// most accurate measured), with the reason in words (`show` names a setting).
+fn cheapest(table: &[(u32, f64)], target: f64, show: impl Fn(u32) -> String) -> (u32, String) {
+    match table.iter().find(|(_, e)| *e <= target) {
+        Some(&(s, e)) => (s, format!("{}: the cheapest measured, mean error {e:.2e} ≤ {target}", show(s))),
+        None => {
+            let &(s, e) = table.last().expect("calibrated");
+            (s, format!("{}: the most accurate measured; its mean error {e:.2e} is still above {target}", show(s)))
+        }
+    }
 }
 
 /// Estimated time and memory of baking `products` (and `levels` of the specular cube).

@@ -483,6 +483,20 @@ pub fn best_per_ms(rows: &[Measurement]) -> Vec<&Measurement> {
         .collect()
 }
 
+/// The fields of a line of `report.csv` (double-quoted fields may hold commas).
+pub fn csv_fields(line: &str) -> Vec<String> {
+    let mut out = vec![String::new()];
+    let mut quoted = false;
+    for c in line.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            ',' if !quoted => out.push(String::new()),
+            _ => out.last_mut().expect("one field").push(c),
+        }
+    }
+    out
+}
+
 fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement]) -> Result<()> {
     // CSV.
     let mut csv = String::from("product,backend,setting,time_ms,mean_error,max_error,metric\n");
