@@ -65,21 +65,13 @@ fn a_failed_run_leaves_the_existing_output_alone() {
 fn lut_writes_exr_and_png() {
     let d = scratch("ok");
     let out = d.join("t.exr");
-    cli::run(["runner", "lut", "--size", "16", "--samples", "64", "--backend", "cpu", "--png", "--out", out.to_str().unwrap()])
-        .expect("bake");
+    cli::run(["runner", "lut", "--size", "16", "--samples", "64", "--backend", "cpu", "--png", "--out", out.to_str().unwrap()]).expect("bake");
     let png = image::open(d.join("t.png")).expect("png").to_rgb8();
     assert_eq!(png.dimensions(), (16, 16));
     // Reading the EXR back gives two 32-bit channels with the table's conventions: the
     // top-left texel (grazing, smooth) has a small scale and a large bias.
     use exr::prelude::*;
-    let img = read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_file(&out)
-        .expect("exr");
+    let img = read().no_deep_data().largest_resolution_level().all_channels().first_valid_layer().all_attributes().from_file(&out).expect("exr");
     let layer = &img.layer_data;
     let names: Vec<String> = layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
     assert_eq!(names, ["G", "R"]);

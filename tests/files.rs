@@ -81,10 +81,13 @@ fn half_float_overflow_rule() {
 
 fn write_exr(path: &Path, w: usize, h: usize, f: impl Fn(usize, usize) -> f32 + Sync) {
     use exr::prelude::*;
-    let img = Image::from_channels((w, h), SpecificChannels::rgb(|p: Vec2<usize>| {
-        let v = f(p.x(), p.y());
-        (v, v, v)
-    }));
+    let img = Image::from_channels(
+        (w, h),
+        SpecificChannels::rgb(|p: Vec2<usize>| {
+            let v = f(p.x(), p.y());
+            (v, v, v)
+        }),
+    );
     img.write().to_file(path).unwrap();
 }
 

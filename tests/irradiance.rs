@@ -90,13 +90,7 @@ fn gpu_matches_cpu() {
     let rel = max_relative(&g.texels, &c.texels, 1e-3);
     let gs = gpu().sh9(&city, 0).unwrap();
     let cs = Backend::Cpu.sh9(&city, 0).unwrap();
-    let sh_rel = gs
-        .radiance
-        .iter()
-        .flatten()
-        .zip(cs.radiance.iter().flatten())
-        .map(|(a, b)| (a - b).abs() / b.abs().max(1e-3))
-        .fold(0.0, f64::max);
+    let sh_rel = gs.radiance.iter().flatten().zip(cs.radiance.iter().flatten()).map(|(a, b)| (a - b).abs() / b.abs().max(1e-3)).fold(0.0, f64::max);
     println!("city.exr: irradiance gpu vs cpu max relative {rel:.2e}; SH9 coefficients {sh_rel:.2e}");
     assert!(rel < 1e-5 && sh_rel < 1e-5, "{rel:e} {sh_rel:e}");
     let _ = Vec3::ZERO;

@@ -12,10 +12,7 @@ fn gpu_matches_cpu() {
     let (size, samples) = (128, 256);
     let g = gpu().brdf_lut(size, samples).expect("gpu bake");
     let c = runner::Backend::Cpu.brdf_lut(size, samples).expect("cpu bake");
-    let (abs, ulp) = max_diffs(
-        g.texels.iter().flat_map(|t| [t.x, t.y]),
-        c.texels.iter().flat_map(|t| [t.x, t.y]),
-    );
+    let (abs, ulp) = max_diffs(g.texels.iter().flat_map(|t| [t.x, t.y]), c.texels.iter().flat_map(|t| [t.x, t.y]));
     println!("brdf lut {size}² × {samples} samples, gpu vs cpu: max |Δ| = {abs:.3e}, max {ulp} ULP");
     assert!(abs <= 1.5e-6, "gpu and cpu differ by {abs:e}");
 }
@@ -97,4 +94,3 @@ fn huge_sample_count() {
     println!("2^24+1 samples at (0.5, 0.5): {v} vs reference ({ra:.7}, {rb:.7})");
     assert!((v.x as f64 - ra).abs() < 1e-5 && (v.y as f64 - rb).abs() < 1e-5);
 }
-

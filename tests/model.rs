@@ -55,7 +55,17 @@ fn loads_with_node_transforms_and_every_texture() {
 /// 8 % of the model's pixels above 2/255, all on texture edges and silhouettes).
 #[test]
 fn gpu_draws_the_model_as_the_cpu_reference() {
-    let settings = Settings { size: 32, source_size: 64, mips: 4, samples: 64, irradiance_size: 8, irradiance_source: 16, lut_size: 32, lut_samples: 64, ..Settings::default() };
+    let settings = Settings {
+        size: 32,
+        source_size: 64,
+        mips: 4,
+        samples: 64,
+        irradiance_size: 8,
+        irradiance_source: 16,
+        lut_size: 32,
+        lut_samples: 64,
+        ..Settings::default()
+    };
     let env = Environment::Equirect(support::environment("courtyard"));
     let baked = bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();
     let mut model = runner::model::load(&sample_path()).unwrap();
@@ -88,10 +98,7 @@ fn gpu_draws_the_model_as_the_cpu_reference() {
         let d: Vec<Vec4> = g.iter().zip(&c).map(|(a, b)| Vec4::splat(((*a - *b).abs().max_element() * 10.0).min(1.0))).collect();
         runner::files::write_png(&dir.join("model_diff.png"), w, h, &runner::render::to_rgb8(&d)).unwrap();
     }
-    println!(
-        "model: {n} pixels; GPU vs CPU mean |Δ| {mean:.2e}, max {worst:.3}, {:.2} % above 2/255",
-        100.0 * over as f64 / n as f64
-    );
+    println!("model: {n} pixels; GPU vs CPU mean |Δ| {mean:.2e}, max {worst:.3}, {:.2} % above 2/255", 100.0 * over as f64 / n as f64);
     assert!(n > (w * h) as usize / 10, "the model covers too little of the frame: {n}");
     assert!(mean < 5e-3, "{mean:e}");
     assert!((over as f64) < 0.12 * n as f64, "{over} of {n}");

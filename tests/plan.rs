@@ -273,7 +273,8 @@ fn the_cache_reuses_unchanged_bakes_and_rebuilds_bad_entries() {
     assert_eq!(bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), true).unwrap().outcome, Outcome::Forced);
 
     // Any parameter changes the key: a sample count, the roughness range, the backend.
-    let more = scene("", &format!("{}\n{}", material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]"), QUICK.replace("samples = 32\nlut", "samples = 33\nlut")));
+    let more =
+        scene("", &format!("{}\n{}", material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]"), QUICK.replace("samples = 32\nlut", "samples = 33\nlut")));
     let other = bake::bake_scene(&Backend::Cpu, &more, &cal, Some(&cache), false).unwrap();
     assert_eq!(other.outcome, Outcome::Baked);
     assert_ne!(other.key, first.key);

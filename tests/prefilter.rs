@@ -129,4 +129,3 @@ fn gpu_matches_cpu() {
         assert!(rel < 1e-5, "{name}: {rel:e}");
     }
 }
-

@@ -68,6 +68,9 @@ fn gpu_matches_the_cpu_reference() {
             }
         }
     }
-    println!("scene 96×64, all {} model combinations: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)", diffuse_model::COUNT * specular_model::COUNT * fresnel_model::COUNT);
+    println!(
+        "scene 96×64, all {} model combinations: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)",
+        diffuse_model::COUNT * specular_model::COUNT * fresnel_model::COUNT
+    );
     assert!(worst_all < 1e-5, "{worst_all:e}");
 }

@@ -124,7 +124,11 @@ fn shading_is_finite_at_the_extremes() {
                                     let c = shade::direct(o, &m, n, v, l, Vec3::splat(radiance));
                                     assert!(c.is_finite() && c.min_element() >= 0.0, "direct r {r} nv {nv} L {radiance:e} l {l}: {c}");
                                 }
-                                let s = IblSample { prefiltered: Vec3::splat(radiance), irradiance: Vec3::splat(radiance), brdf: splitsum_shaders::lut::integrate_brdf(nv, r, 16) };
+                                let s = IblSample {
+                                    prefiltered: Vec3::splat(radiance),
+                                    irradiance: Vec3::splat(radiance),
+                                    brdf: splitsum_shaders::lut::integrate_brdf(nv, r, 16),
+                                };
                                 let c = shade::ibl(o, &m, n, v, s);
                                 assert!(c.is_finite() && c.min_element() >= 0.0, "ibl r {r} nv {nv} L {radiance:e}: {c}");
                             }
@@ -161,7 +165,18 @@ fn extreme_environment_bakes_and_renders_finite() {
     assert_eq!(report.clamped, 2, "f32::MAX and +∞ (made the channel's largest finite value) are clamped");
     assert!(texels.iter().all(|t| t.max_element() <= MAX_RADIANCE));
     let env = Environment::Equirect(runner::texture::Equirect { width: w, height: h, texels });
-    let settings = Settings { size: 8, source_size: 16, mips: 4, samples: 64, irradiance_size: 4, irradiance_source: 8, sh_source: 8, lut_size: 8, lut_samples: 16, ..Settings::default() };
+    let settings = Settings {
+        size: 8,
+        source_size: 16,
+        mips: 4,
+        samples: 64,
+        irradiance_size: 4,
+        irradiance_source: 8,
+        sh_source: 8,
+        lut_size: 8,
+        lut_samples: 16,
+        ..Settings::default()
+    };
     for b in backends() {
         let baked = bake::bake(b, &env, &settings, Products::ALL).unwrap();
         let all = baked.source.texels.iter().chain(&baked.specular.as_ref().unwrap().texels).chain(&baked.irradiance.as_ref().unwrap().texels);

@@ -67,7 +67,17 @@ fn the_viewer_window_shows_the_scene() {
     let (_xvfb, display) = start_xvfb();
     // SAFETY: this test binary runs this one test; nothing else reads the environment now.
     unsafe { std::env::set_var("DISPLAY", &display) };
-    let settings = Settings { size: 32, source_size: 64, mips: 4, samples: 64, irradiance_size: 8, irradiance_source: 16, lut_size: 32, lut_samples: 64, ..Settings::default() };
+    let settings = Settings {
+        size: 32,
+        source_size: 64,
+        mips: 4,
+        samples: 64,
+        irradiance_size: 8,
+        irradiance_source: 16,
+        lut_size: 32,
+        lut_samples: 64,
+        ..Settings::default()
+    };
     let env = Environment::Equirect(support::environment("courtyard"));
     let baked = bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();
     let (w, h) = (320u32, 200u32);

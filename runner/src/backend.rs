@@ -13,9 +13,7 @@ use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
-use splitsum_shaders::kernels::{
-    self, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, probe_mode,
-};
+use splitsum_shaders::kernels::{self, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, probe_mode};
 use splitsum_shaders::math::{CHUNK, MeanPartial};
 use splitsum_shaders::{equirect, lut, prefilter};
 
@@ -171,9 +169,8 @@ impl Backend {
     }
 
     fn gpu_mips(&self, g: &Gpu, cube: &wgpu::Buffer, layout: CubeLayout) {
-        let params: Vec<DownsampleParams> = (0..layout.levels.saturating_sub(1))
-            .map(|level| DownsampleParams { size: layout.size, levels: layout.levels, level, pad: 0 })
-            .collect();
+        let params: Vec<DownsampleParams> =
+            (0..layout.levels.saturating_sub(1)).map(|level| DownsampleParams { size: layout.size, levels: layout.levels, level, pad: 0 }).collect();
         let dispatches: Vec<Dispatch> = params
             .iter()
             .map(|p| {
@@ -270,23 +267,9 @@ impl Backend {
         let s = src.layout.level_size(level);
         let t = gpu::groups(size, kernels::TILE);
         for (start, count) in chunks(FACES * s * s) {
-            let p = IrradianceParams {
-                src_size: src.layout.size,
-                src_levels: src.layout.levels,
-                src_level: level,
-                dst_size: size,
-                start,
-                count,
-                pad0: 0,
-                pad1: 0,
-            };
-            g.run(&[Dispatch {
-                kernel: Kernel::IrradianceCube,
-                params: bytemuck::bytes_of(&p),
-                input: Some(&input),
-                output: &accum,
-                groups: [t, t, FACES],
-            }]);
+            let p =
+                IrradianceParams { src_size: src.layout.size, src_levels: src.layout.levels, src_level: level, dst_size: size, start, count, pad0: 0, pad1: 0 };
+            g.run(&[Dispatch { kernel: Kernel::IrradianceCube, params: bytemuck::bytes_of(&p), input: Some(&input), output: &accum, groups: [t, t, FACES] }]);
         }
         let sums = read_vec4(g, &accum, 3 * layout.texel_count())?;
         let texels = (0..layout.texel_count() as usize).map(|i| partial(&sums, i).resolve()).collect();

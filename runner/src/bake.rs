@@ -206,9 +206,7 @@ pub fn source_cube(backend: &Backend, env: &Environment, settings: &Settings) ->
         Environment::Cube(c) => {
             let f = c.layout.size;
             if f < size {
-                return Err(Error::Invalid(format!(
-                    "--source-size {size} is larger than the cube's {f}×{f} faces; upsampling adds nothing"
-                )));
+                return Err(Error::Invalid(format!("--source-size {size} is larger than the cube's {f}×{f} faces; upsampling adds nothing")));
             }
             let mut full = Cube { layout: CubeLayout::new(f, CubeLayout::full_chain(f)), texels: c.texels.clone() };
             full.texels.resize(full.layout.texel_count() as usize, Default::default());
@@ -245,11 +243,7 @@ pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products:
     } else {
         None
     };
-    let lut = if products.lut {
-        Some(timed(&mut timings, "brdf lut", || backend.brdf_lut(settings.lut_size, settings.lut_samples))?)
-    } else {
-        None
-    };
+    let lut = if products.lut { Some(timed(&mut timings, "brdf lut", || backend.brdf_lut(settings.lut_size, settings.lut_samples))?) } else { None };
     Ok(Baked { source, specular, irradiance, sh9, lut, timings })
 }
 

@@ -1,13 +1,13 @@
 //! The command line: parsing with clap, then orchestration of backends and files.
 
-use anyhow::Context;
-use clap::{Args, Parser, Subcommand};
 use crate::bake::{self, Mapping, Products, Settings};
 use crate::environment;
 use crate::files;
 use crate::ktx2::Format;
 use crate::scene::{DiffuseArg, FresnelArg, SpecularArg, TonemapArg};
 use crate::{Backend, BackendKind};
+use anyhow::Context;
+use clap::{Args, Parser, Subcommand};
 use splitsum_shaders::cubemap::CubeLayout;
 use std::path::PathBuf;
 use std::time::Instant;
@@ -77,7 +77,9 @@ impl SceneArgs {
         let short = &sb.key[..12];
         match &sb.outcome {
             bake::Outcome::CacheHit => println!("cache hit {short}: nothing to bake ({})", cache.entry(&sb.key).display()),
-            bake::Outcome::Baked => println!("baked {} on {} in {:.2} s; cached as {short}", scene_path.display(), backend.describe(), start.elapsed().as_secs_f64()),
+            bake::Outcome::Baked => {
+                println!("baked {} on {} in {:.2} s; cached as {short}", scene_path.display(), backend.describe(), start.elapsed().as_secs_f64())
+            }
             bake::Outcome::Forced => println!("baked again (--force) in {:.2} s; cached as {short}", start.elapsed().as_secs_f64()),
             bake::Outcome::Rebuilt(why) => println!("cache entry {short} rejected ({why}); baked again in {:.2} s", start.elapsed().as_secs_f64()),
         }
@@ -239,15 +241,7 @@ impl DisplayBakeArgs {
             environment::Environment::Equirect(e) => (e.width / 4).max(1).next_power_of_two().min(1024),
             environment::Environment::Cube(c) => c.layout.size.min(1024),
         };
-        Settings {
-            size: self.size,
-            source_size: native.max(self.size),
-            mips,
-            samples: self.samples,
-            lut_size: 128,
-            lut_samples: 512,
-            ..Settings::default()
-        }
+        Settings { size: self.size, source_size: native.max(self.size), mips, samples: self.samples, lut_size: 128, lut_samples: 512, ..Settings::default() }
     }
 }
 
@@ -428,14 +422,7 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     let lut = backend.brdf_lut(args.size, args.samples)?;
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
-    println!(
-        "brdf lut {}x{} at {} samples/texel on {}: bake {:.3} s",
-        args.size,
-        args.size,
-        args.samples,
-        backend.describe(),
-        secs
-    );
+    println!("brdf lut {}x{} at {} samples/texel on {}: bake {:.3} s", args.size, args.size, args.samples, backend.describe(), secs);
     println!("wrote {}", args.out.display());
     if let Some(p) = png {
         files::write_png(&p, lut.size, lut.size, &files::lut_preview(&lut))?;
@@ -488,11 +475,7 @@ fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
     }
     println!("  {:<12} {:>9.3} s", "total", manifest.timings.iter().map(|t| t.seconds).sum::<f64>());
     if let Some(e) = manifest.sh9_vs_convolution {
-        println!(
-            "  SH9 irradiance vs the convolution: max relative error {:.1} %, rms {:.1} %",
-            100.0 * e.max_relative,
-            100.0 * e.rms_relative
-        );
+        println!("  SH9 irradiance vs the convolution: max relative error {:.1} %, rms {:.1} %", 100.0 * e.max_relative, 100.0 * e.rms_relative);
     }
     println!("wrote {} files to {}", manifest.files.len() + 1, args.out.display());
     Ok(())

@@ -13,9 +13,7 @@ use splitsum_shaders::{equirect, lut, prefilter};
 pub fn progress(what: &str, len: u64) -> ProgressBar {
     let bar = ProgressBar::new(len);
     bar.set_style(
-        ProgressStyle::with_template("{prefix:>12} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})")
-            .expect("valid template")
-            .progress_chars("=> "),
+        ProgressStyle::with_template("{prefix:>12} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})").expect("valid template").progress_chars("=> "),
     );
     bar.set_prefix(what.to_string());
     bar
@@ -75,9 +73,7 @@ pub fn equirect_to_cube(env: &Equirect, size: u32, supersample: u32) -> Cube {
     let levels = equirect::pyramid_levels(env.width);
     let bar = progress("equirect", (FACES * size) as u64);
     let level0 = &mut texels[..(FACES * size * size) as usize];
-    fill_level(level0, size, &bar, |face, x, y| {
-        equirect::cube_texel(&pyramid, env.width, env.height, levels, face, x, y, size, supersample)
-    });
+    fill_level(level0, size, &bar, |face, x, y| equirect::cube_texel(&pyramid, env.width, env.height, levels, face, x, y, size, supersample));
     bar.finish_and_clear();
     Cube { layout, texels }
 }
@@ -111,9 +107,7 @@ pub fn prefilter(src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32],
         let start = out.level_offset(m) as usize;
         let level = &mut texels[start..start + (FACES * s * s) as usize];
         let r = roughness[m as usize];
-        fill_level(level, s, &bar, |face, x, y| {
-            prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples, lod_bias)
-        });
+        fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples, lod_bias));
     }
     bar.finish_and_clear();
     Cube { layout: out, texels }
@@ -124,9 +118,7 @@ pub fn irradiance(src: &Cube, level: u32, size: u32) -> Cube {
     let layout = CubeLayout::new(size, 1);
     let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
     let bar = progress("irradiance", (FACES * size) as u64);
-    fill_level(&mut texels, size, &bar, |face, x, y| {
-        irradiance::convolve_dir(&src.texels, src.layout, level, cubemap::texel_dir(face, x, y, size))
-    });
+    fill_level(&mut texels, size, &bar, |face, x, y| irradiance::convolve_dir(&src.texels, src.layout, level, cubemap::texel_dir(face, x, y, size)));
     bar.finish_and_clear();
     Cube { layout, texels }
 }
@@ -134,8 +126,5 @@ pub fn irradiance(src: &Cube, level: u32, size: u32) -> Cube {
 /// The per-row SH9 partial sums of level `level` of `src` (see `irradiance::sh9_row`).
 pub fn sh9_rows(src: &Cube, level: u32) -> Vec<[Vec4; SH9 + 1]> {
     let s = src.layout.level_size(level);
-    (0..FACES * s)
-        .into_par_iter()
-        .map(|row| irradiance::sh9_row(&src.texels, src.layout, level, row / s, row % s))
-        .collect()
+    (0..FACES * s).into_par_iter().map(|row| irradiance::sh9_row(&src.texels, src.layout, level, row / s, row % s)).collect()
 }

@@ -114,10 +114,7 @@ fn check_equirect_shape(path: &Path, width: u32, height: u32) -> Result<()> {
         return Err(Error::file(path, format!("{width}×{height} is too small for an environment (at least {MIN_WIDTH}×{})", MIN_WIDTH / 2)));
     }
     if width != 2 * height {
-        return Err(Error::file(
-            path,
-            format!("an equirectangular environment is twice as wide as high, this one is {width}×{height}"),
-        ));
+        return Err(Error::file(path, format!("an equirectangular environment is twice as wide as high, this one is {width}×{height}")));
     }
     Ok(())
 }
@@ -138,14 +135,11 @@ pub fn read_image(path: &Path) -> Result<(u32, u32, Vec<Vec4>)> {
 
 fn read_hdr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Vec4>)> {
     use image::ImageDecoder;
-    let decoder = image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes))
-        .map_err(|e| Error::file(path, format!("malformed Radiance HDR: {e}")))?;
+    let decoder = image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes)).map_err(|e| Error::file(path, format!("malformed Radiance HDR: {e}")))?;
     let (w, h) = decoder.dimensions();
     check_side(path, w, h)?;
     let mut buf = vec![0u8; decoder.total_bytes() as usize];
-    decoder
-        .read_image(&mut buf)
-        .map_err(|e| Error::file(path, format!("truncated or malformed Radiance HDR: {e}")))?;
+    decoder.read_image(&mut buf).map_err(|e| Error::file(path, format!("truncated or malformed Radiance HDR: {e}")))?;
     let rgb: Vec<f32> = bytemuck::pod_collect_to_vec(&buf);
     Ok((w, h, rgb.chunks_exact(3).map(|c| Vec4::new(c[0], c[1], c[2], 1.0)).collect()))
 }

@@ -59,13 +59,10 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> std
 pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
     use exr::prelude::*;
     let size = lut.size as usize;
-    let pixels = SpecificChannels::build()
-        .with_channel("R")
-        .with_channel("G")
-        .with_pixel_fn(|pos: Vec2<usize>| {
-            let t = lut.texels[pos.y() * size + pos.x()];
-            (t.x, t.y)
-        });
+    let pixels = SpecificChannels::build().with_channel("R").with_channel("G").with_pixel_fn(|pos: Vec2<usize>| {
+        let t = lut.texels[pos.y() * size + pos.x()];
+        (t.x, t.y)
+    });
     let image = Image::from_channels((size, size), pixels);
     let mut buf = std::io::Cursor::new(Vec::new());
     image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file(path, format!("could not encode: {e}")))?;
@@ -74,8 +71,7 @@ pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
 
 /// Writes an 8-bit RGB PNG from row-major `rgb` (values already in [0, 255]).
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()> {
-    let img = image::RgbImage::from_raw(width, height, rgb.to_vec())
-        .ok_or_else(|| Error::file(path, "image buffer has the wrong size"))?;
+    let img = image::RgbImage::from_raw(width, height, rgb.to_vec()).ok_or_else(|| Error::file(path, "image buffer has the wrong size"))?;
     write_atomic(path, |w| {
         let mut buf = std::io::Cursor::new(Vec::new());
         img.write_to(&mut buf, image::ImageFormat::Png).map_err(std::io::Error::other)?;
@@ -86,10 +82,7 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()>
 /// The BRDF table as an 8-bit preview: R = scale, G = bias, values in [0, 1] stored
 /// linearly (it is data, not colour).
 pub fn lut_preview(lut: &Lut) -> Vec<u8> {
-    lut.texels
-        .iter()
-        .flat_map(|t| [to_u8(t.x), to_u8(t.y), 0])
-        .collect()
+    lut.texels.iter().flat_map(|t| [to_u8(t.x), to_u8(t.y), 0]).collect()
 }
 
 fn to_u8(v: f32) -> u8 {

@@ -73,13 +73,13 @@ fn dfd(bytes: u32) -> Vec<u32> {
     let samples = 4u32;
     let block_size = 24 + 16 * samples;
     let mut d = vec![
-        4 + block_size, // dfdTotalSize
-        0,              // vendorId = Khronos (0), descriptorType = basic (0)
-        2 | (block_size << 16), // versionNumber = 2 (KDF 1.3), descriptorBlockSize
+        4 + block_size,           // dfdTotalSize
+        0,                        // vendorId = Khronos (0), descriptorType = basic (0)
+        2 | (block_size << 16),   // versionNumber = 2 (KDF 1.3), descriptorBlockSize
         1 | (1 << 8) | (1 << 16), // model RGBSDA, primaries BT709, transfer linear, flags straight alpha
-        0,              // texel block dimensions 1×1×1×1
-        4 * bytes,      // bytesPlane0
-        0,              // bytesPlane4..7
+        0,                        // texel block dimensions 1×1×1×1
+        4 * bytes,                // bytesPlane0
+        0,                        // bytesPlane4..7
     ];
     let bits = 8 * bytes;
     for (i, channel) in [0u32, 1, 2, 15].iter().enumerate() {

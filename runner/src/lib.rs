@@ -20,8 +20,8 @@ pub mod plot;
 pub mod preview;
 pub mod raster;
 pub mod render;
-pub mod scene;
 pub mod report;
+pub mod scene;
 pub mod texture;
 pub mod view;
 

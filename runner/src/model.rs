@@ -133,14 +133,7 @@ fn from_document(path: &Path, doc: gltf::Document, buffers: Vec<gltf::buffer::Da
     Ok(Model { primitives })
 }
 
-fn visit(
-    path: &Path,
-    node: &gltf::Node,
-    parent: Mat4,
-    buffers: &[gltf::buffer::Data],
-    images: &[gltf::image::Data],
-    out: &mut Vec<Primitive>,
-) -> Result<()> {
+fn visit(path: &Path, node: &gltf::Node, parent: Mat4, buffers: &[gltf::buffer::Data], images: &[gltf::image::Data], out: &mut Vec<Primitive>) -> Result<()> {
     let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
     if let Some(mesh) = node.mesh() {
         for prim in mesh.primitives() {
@@ -158,11 +151,7 @@ fn visit(
 
 fn primitive(path: &Path, prim: &gltf::Primitive, world: Mat4, buffers: &[gltf::buffer::Data], images: &[gltf::image::Data]) -> Result<Primitive> {
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-    let positions: Vec<Vec3> = reader
-        .read_positions()
-        .ok_or_else(|| Error::file(path, "a primitive has no POSITION"))?
-        .map(Vec3::from)
-        .collect();
+    let positions: Vec<Vec3> = reader.read_positions().ok_or_else(|| Error::file(path, "a primitive has no POSITION"))?.map(Vec3::from).collect();
     let n = positions.len();
     let indices: Vec<u32> = match reader.read_indices() {
         Some(i) => i.into_u32().collect(),

@@ -94,12 +94,7 @@ impl Calibration {
 
     fn prefilter_error(&self, roughness: f32, samples: u32) -> f64 {
         // The measured roughness nearest to the one asked for.
-        let table = &self
-            .prefilter
-            .iter()
-            .min_by(|a, b| (a.0 - roughness).abs().total_cmp(&(b.0 - roughness).abs()))
-            .expect("calibrated")
-            .1;
+        let table = &self.prefilter.iter().min_by(|a, b| (a.0 - roughness).abs().total_cmp(&(b.0 - roughness).abs())).expect("calibrated").1;
         interpolate(table, samples)
     }
 }
@@ -322,11 +317,8 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     settings.samples = match (q.samples, target) {
         (Some(n), _) => n,
         (None, Some(e)) if specular => {
-            let table: Vec<(u32, f64)> = cal.prefilter[0]
-                .1
-                .iter()
-                .map(|&(n, _)| (n, needed_r.iter().map(|&r| cal.prefilter_error(r, n)).fold(0.0, f64::max)))
-                .collect();
+            let table: Vec<(u32, f64)> =
+                cal.prefilter[0].1.iter().map(|&(n, _)| (n, needed_r.iter().map(|&r| cal.prefilter_error(r, n)).fold(0.0, f64::max))).collect();
             let (n, why) = cheapest(&table, e, |n| n.to_string());
             decide("prefilter samples", true, why);
             n

@@ -55,11 +55,7 @@ pub fn bilinear(width: u32, height: u32, rgba: &[u8], srgb: bool, uv: Vec2) -> V
     let texel = |x: i64, y: i64| -> Vec4 {
         let i = 4 * (wrap(y, height) * width as usize + wrap(x, width));
         let c = |k: usize| rgba[i + k] as f32 / 255.0;
-        if srgb {
-            Vec4::new(srgb_to_linear(c(0)), srgb_to_linear(c(1)), srgb_to_linear(c(2)), c(3))
-        } else {
-            Vec4::new(c(0), c(1), c(2), c(3))
-        }
+        if srgb { Vec4::new(srgb_to_linear(c(0)), srgb_to_linear(c(1)), srgb_to_linear(c(2)), c(3)) } else { Vec4::new(c(0), c(1), c(2), c(3)) }
     };
     let (x0, y0) = (x0 as i64, y0 as i64);
     let a = texel(x0, y0) * (1.0 - tx) + texel(x0 + 1, y0) * tx;
@@ -155,26 +151,23 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
     // Shading of the visible fragments.
     let textures: Vec<Vec<Option<MipTexture>>> =
         model.primitives.iter().map(|p| p.textures.iter().map(|t| t.as_ref().map(MipTexture::new)).collect()).collect();
-    colour
-        .par_iter_mut()
-        .zip(nearest.par_iter())
-        .for_each(|(c, f)| {
-            let Some(f) = f else { return };
-            let prim = &model.primitives[f.prim];
-            let t = &prim.indices[3 * f.tri..3 * f.tri + 3];
-            let v = |k: usize| &prim.vertices[t[k] as usize];
-            let mix3 = |g: &dyn Fn(usize) -> Vec3| g(0) * f.bary.x + g(1) * f.bary.y + g(2) * f.bary.z;
-            let position = mix3(&|k| Vec3::from(v(k).position));
-            let normal = mix3(&|k| Vec3::from(v(k).normal));
-            let tangent = Vec4::from(v(0).tangent) * f.bary.x + Vec4::from(v(1).tangent) * f.bary.y + Vec4::from(v(2).tangent) * f.bary.z;
-            let uv_at = |b: Vec3| Vec2::from(v(0).uv) * b.x + Vec2::from(v(1).uv) * b.y + Vec2::from(v(2).uv) * b.z;
-            let uv = uv_at(f.bary);
-            let (dx, dy) = (uv_at(f.quad[1]) - uv_at(f.quad[0]), uv_at(f.quad[2]) - uv_at(f.quad[0]));
-            let read = |k: usize| textures[f.prim][k].as_ref().map_or(Vec4::ONE, |tex| tex.sample(uv, dx, dy));
-            let texels = Texels { base_color: read(0), metallic_roughness: read(1), normal: read(2), occlusion: read(3), emissive: read(4) };
-            let (m, n) = surface::material(&prim.material, &texels, normal, tangent);
-            let view = splitsum_shaders::sampling::normalize_or(frame.eye.truncate() - position, n);
-            *c = scene::shade_point(frame, prim.material.options, &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &m, position, n, view);
-        });
+    colour.par_iter_mut().zip(nearest.par_iter()).for_each(|(c, f)| {
+        let Some(f) = f else { return };
+        let prim = &model.primitives[f.prim];
+        let t = &prim.indices[3 * f.tri..3 * f.tri + 3];
+        let v = |k: usize| &prim.vertices[t[k] as usize];
+        let mix3 = |g: &dyn Fn(usize) -> Vec3| g(0) * f.bary.x + g(1) * f.bary.y + g(2) * f.bary.z;
+        let position = mix3(&|k| Vec3::from(v(k).position));
+        let normal = mix3(&|k| Vec3::from(v(k).normal));
+        let tangent = Vec4::from(v(0).tangent) * f.bary.x + Vec4::from(v(1).tangent) * f.bary.y + Vec4::from(v(2).tangent) * f.bary.z;
+        let uv_at = |b: Vec3| Vec2::from(v(0).uv) * b.x + Vec2::from(v(1).uv) * b.y + Vec2::from(v(2).uv) * b.z;
+        let uv = uv_at(f.bary);
+        let (dx, dy) = (uv_at(f.quad[1]) - uv_at(f.quad[0]), uv_at(f.quad[2]) - uv_at(f.quad[0]));
+        let read = |k: usize| textures[f.prim][k].as_ref().map_or(Vec4::ONE, |tex| tex.sample(uv, dx, dy));
+        let texels = Texels { base_color: read(0), metallic_roughness: read(1), normal: read(2), occlusion: read(3), emissive: read(4) };
+        let (m, n) = surface::material(&prim.material, &texels, normal, tangent);
+        let view = splitsum_shaders::sampling::normalize_or(frame.eye.truncate() - position, n);
+        *c = scene::shade_point(frame, prim.material.options, &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &m, position, n, view);
+    });
     colour.into_iter().map(|c| scene::to_display(frame, c)).collect()
 }

@@ -5,7 +5,6 @@
 use crate::error::{Error, Result};
 use crate::gpu::Gpu;
 use crate::model::{Model, SLOTS, Texture, Vertex};
-use wgpu::util::DeviceExt;
 use crate::texture::{Cube, Lut};
 use rayon::prelude::*;
 use splitsum_shaders::glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
@@ -13,6 +12,7 @@ use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::scene::{self, Frame, Light, MAX_LIGHTS};
 use splitsum_shaders::shade::{EnvironmentShape, ShadeOptions, diffuse_model, fresnel_model, specular_model};
 use splitsum_shaders::tonemap::Tonemapper;
+use wgpu::util::DeviceExt;
 
 /// The baked products the display reads.
 #[derive(Clone)]
@@ -447,12 +447,7 @@ impl GpuScene {
 pub fn perspective(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
     let h = 1.0 / (0.5 * fov_y).tan();
     let r = far / (near - far);
-    Mat4::from_cols(
-        Vec4::new(h / aspect, 0.0, 0.0, 0.0),
-        Vec4::new(0.0, h, 0.0, 0.0),
-        Vec4::new(0.0, 0.0, r, -1.0),
-        Vec4::new(0.0, 0.0, r * near, 0.0),
-    )
+    Mat4::from_cols(Vec4::new(h / aspect, 0.0, 0.0, 0.0), Vec4::new(0.0, h, 0.0, 0.0), Vec4::new(0.0, 0.0, r, -1.0), Vec4::new(0.0, 0.0, r * near, 0.0))
 }
 
 /// World to view space for a camera at `eye` with orthonormal `forward`, `right`, `up`.
@@ -540,8 +535,7 @@ impl GpuModel {
                     contents: bytemuck::bytes_of(&p.material),
                     usage: wgpu::BufferUsages::UNIFORM,
                 });
-                let views: Vec<wgpu::TextureView> =
-                    p.textures.iter().map(|t| upload_texture(gpu, t.as_ref().unwrap_or(&white))).collect();
+                let views: Vec<wgpu::TextureView> = p.textures.iter().map(|t| upload_texture(gpu, t.as_ref().unwrap_or(&white))).collect();
                 let mut group = vec![wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }];
                 for (k, v) in views.iter().enumerate() {
                     group.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: wgpu::BindingResource::TextureView(v) });

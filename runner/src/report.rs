@@ -123,7 +123,12 @@ impl Sweep {
         let q = &samples;
         let qualities = vec![
             level(&format!("q1 ({} samples)", q[0]), q[0], lut_sizes[0], irradiance_sources[0]),
-            level(&format!("q2 ({} samples)", q[q.len() / 2]), q[q.len() / 2], lut_sizes[lut_sizes.len() / 2], irradiance_sources[irradiance_sources.len() / 2]),
+            level(
+                &format!("q2 ({} samples)", q[q.len() / 2]),
+                q[q.len() / 2],
+                lut_sizes[lut_sizes.len() / 2],
+                irradiance_sources[irradiance_sources.len() / 2],
+            ),
             level(&format!("q3 ({} samples)", q[q.len() - 1]), q[q.len() - 1], *lut_sizes.last().expect("sizes"), *irradiance_sources.last().expect("sizes")),
         ];
         Self {
@@ -269,10 +274,7 @@ impl References {
             .collect();
         let prefilter_dirs = directions(sweep.directions);
         let roughness: Vec<f32> = (0..sweep.mips).map(|m| RoughnessMapping::Linear.roughness(m, sweep.mips)).collect();
-        let prefilter = roughness
-            .iter()
-            .map(|&r| prefilter_dirs.par_iter().map(|&n| reference::prefilter(texels, arr(n), r as f64)).collect())
-            .collect();
+        let prefilter = roughness.iter().map(|&r| prefilter_dirs.par_iter().map(|&n| reference::prefilter(texels, arr(n), r as f64)).collect()).collect();
         let irradiance_dirs = directions(2 * sweep.directions);
         let irradiance = irradiance_dirs.par_iter().map(|&n| reference::irradiance(texels, arr(n))).collect();
         // Shading points: rough enough that a sum over the source's texels resolves the
@@ -332,16 +334,20 @@ fn lut_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References) -> Res
         let (table, ms) = timed(|| backend.brdf_lut(sweep.lut_size, n))?;
         let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
         let (mean, max) = mean_max(&errors);
-        rows.push(Measurement { product: "brdf lut".into(), backend: b.into(), setting: format!("{n} samples"), time_ms: ms, mean_error: mean, max_error: max, metric: ABS });
+        rows.push(Measurement {
+            product: "brdf lut".into(),
+            backend: b.into(),
+            setting: format!("{n} samples"),
+            time_ms: ms,
+            mean_error: mean,
+            max_error: max,
+            metric: ABS,
+        });
     }
     let n = *sweep.samples.last().expect("samples");
     for &size in &sweep.lut_sizes {
         let (table, ms) = timed(|| backend.brdf_lut(size, n))?;
-        let errors: Vec<f64> = refs
-            .lut_points
-            .iter()
-            .map(|(p, r)| (lut::sample(&table.texels, size, p.x, p.y) - *r).abs().max_element() as f64)
-            .collect();
+        let errors: Vec<f64> = refs.lut_points.iter().map(|(p, r)| (lut::sample(&table.texels, size, p.x, p.y) - *r).abs().max_element() as f64).collect();
         let (mean, max) = mean_max(&errors);
         rows.push(Measurement {
             product: "brdf lut lookup".into(),
@@ -419,7 +425,15 @@ fn irradiance_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References,
         let coeffs = sh.as_vec4();
         let errors: Vec<f64> = refs.irradiance_dirs.iter().zip(&refs.irradiance).map(|(&d, r)| rel(sh9_irradiance(&coeffs, d), *r)).collect();
         let (mean, max) = mean_max(&errors);
-        rows.push(Measurement { product: "irradiance (SH9)".into(), backend: b.into(), setting: format!("{s}x{s} source"), time_ms: ms, mean_error: mean, max_error: max, metric: REL });
+        rows.push(Measurement {
+            product: "irradiance (SH9)".into(),
+            backend: b.into(),
+            setting: format!("{s}x{s} source"),
+            time_ms: ms,
+            mean_error: mean,
+            max_error: max,
+            metric: REL,
+        });
     }
     Ok(rows)
 }
@@ -508,9 +522,16 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
     // Markdown.
     let mut md = String::new();
     let _ = writeln!(md, "# splitsum: error against run time\n");
-    let _ = writeln!(md, "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)).", sweep.source_size, sweep.specular_size, sweep.mips);
+    let _ = writeln!(
+        md,
+        "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)).",
+        sweep.source_size, sweep.specular_size, sweep.mips
+    );
     let _ = writeln!(md, "Backends: {}.\n", backends.iter().map(|b| b.describe()).collect::<Vec<_>>().join("; "));
-    let _ = writeln!(md, "References (f64, independent of the code under test): adaptive Gauss-Kronrod quadrature for the BRDF table; exact sums over every texel of the source for the prefilter and the irradiance; the full reflectance integral (no split) for the shaded colour. Errors are absolute for the table and relative luminance otherwise. Times are wall-clock, uploads and readbacks included.\n");
+    let _ = writeln!(
+        md,
+        "References (f64, independent of the code under test): adaptive Gauss-Kronrod quadrature for the BRDF table; exact sums over every texel of the source for the prefilter and the irradiance; the full reflectance integral (no split) for the shaded colour. Errors are absolute for the table and relative luminance otherwise. Times are wall-clock, uploads and readbacks included.\n"
+    );
     let mut products: Vec<&str> = Vec::new();
     for r in rows {
         if !products.contains(&r.product.as_str()) {
@@ -524,7 +545,10 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
             let _ = writeln!(md, "| {} | {} | {} | {:.2e} | {:.2e} |", r.backend, r.setting, t, r.mean_error, r.max_error);
         }
     }
-    let _ = writeln!(md, "\n## Best error per millisecond (smallest mean error x time)\n\n| product | backend | setting | time (ms) | mean error |\n|---|---|---|---:|---:|");
+    let _ = writeln!(
+        md,
+        "\n## Best error per millisecond (smallest mean error x time)\n\n| product | backend | setting | time (ms) | mean error |\n|---|---|---|---:|---:|"
+    );
     for r in best_per_ms(rows) {
         let _ = writeln!(md, "| {} | {} | {} | {:.1} | {:.2e} |", r.product, r.backend, r.setting, r.time_ms, r.mean_error);
     }
@@ -554,4 +578,3 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
     files::write_png(&dir.join("error_vs_time.png"), canvas.width, canvas.height, &canvas.rgb)?;
     Ok(())
 }
-

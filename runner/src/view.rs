@@ -190,9 +190,7 @@ impl ApplicationHandler for App {
             return;
         }
         let (w, h) = self.options.size;
-        let attributes = Window::default_attributes()
-            .with_title(self.title())
-            .with_inner_size(winit::dpi::PhysicalSize::new(w, h));
+        let attributes = Window::default_attributes().with_title(self.title()).with_inner_size(winit::dpi::PhysicalSize::new(w, h));
         let window = match event_loop.create_window(attributes) {
             Ok(w) => Arc::new(w),
             Err(e) => {
@@ -245,9 +243,7 @@ impl ApplicationHandler for App {
                 self.changed();
             }
             WindowEvent::RedrawRequested => self.draw(),
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
-                self.key(&event.logical_key, event_loop)
-            }
+            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => self.key(&event.logical_key, event_loop),
             WindowEvent::MouseInput { button: MouseButton::Left, state, .. } => {
                 self.dragging = state == ElementState::Pressed;
             }

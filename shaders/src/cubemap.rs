@@ -203,11 +203,7 @@ fn tap(texels: &[Vec4], layout: CubeLayout, level: u32, face: u32, s: u32, x: i3
     let si = s as i32;
     let x_in = x >= 0 && x < si;
     let y_in = y >= 0 && y < si;
-    if x_in || y_in {
-        (texels[tap_index(layout, level, face, x, y, s) as usize] * w, w)
-    } else {
-        (Vec4::ZERO, 0.0)
-    }
+    if x_in || y_in { (texels[tap_index(layout, level, face, x, y, s) as usize] * w, w) } else { (Vec4::ZERO, 0.0) }
 }
 
 /// Seamless bilinear lookup of level `level` in direction `d` (need not be unit length).

@@ -149,10 +149,7 @@ pub fn cube_texel(pyramid: &[Vec4], width: u32, height: u32, levels: u32, face: 
     while j < n {
         let mut i = 0;
         while i < n {
-            let uv = Vec2::new(
-                (x as f32 + (i as f32 + 0.5) / nf) / s,
-                (y as f32 + (j as f32 + 0.5) / nf) / s,
-            );
+            let uv = Vec2::new((x as f32 + (i as f32 + 0.5) / nf) / s, (y as f32 + (j as f32 + 0.5) / nf) / s);
             let p = cubemap::face_uv_to_cube(face, uv);
             let r2 = p.dot(p);
             let r = math::sqrt(r2);

@@ -78,11 +78,7 @@ pub fn max(a: f32, b: f32) -> f32 {
 /// `x` clamped to `[lo, hi]`; NaN becomes `lo`.
 #[inline]
 pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
-    if x > lo {
-        if x < hi { x } else { hi }
-    } else {
-        lo
-    }
+    if x > lo { if x < hi { x } else { hi } } else { lo }
 }
 
 /// `(sin 2πt, cos 2πt)` for any finite `t` (an angle in turns).
@@ -154,12 +150,7 @@ pub fn exp2(x: f32) -> f32 {
     let f = x - n; // f ∈ [−½, ½], exact
     let g = f * core::f32::consts::LN_2;
     // e^g, Taylor to degree 7 (truncation < 6·10⁻⁹ relative on |g| ≤ ln2/2).
-    let p = 1.0
-        + g * (1.0
-            + g * (0.5
-                + g * (1.666_666_7e-1
-                    + g * (4.166_666_6e-2
-                        + g * (8.333_333e-3 + g * (1.388_888_9e-3 + g * 1.984_127e-4))))));
+    let p = 1.0 + g * (1.0 + g * (0.5 + g * (1.666_666_7e-1 + g * (4.166_666_6e-2 + g * (8.333_333e-3 + g * (1.388_888_9e-3 + g * 1.984_127e-4))))));
     let ni = n as i32;
     if ni >= -126 {
         p * f32::from_bits(((ni + 127) as u32) << 23)

@@ -153,17 +153,7 @@ pub fn mirror_texel(src: &[Vec4], layout: CubeLayout, face: u32, x: u32, y: u32,
 /// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`: the source
 /// texel itself at roughness 0 ([`mirror_texel`]), else [`prefilter_dir`] at the texel
 /// centre.
-pub fn prefilter_texel(
-    src: &[Vec4],
-    layout: CubeLayout,
-    face: u32,
-    x: u32,
-    y: u32,
-    dst_size: u32,
-    roughness: f32,
-    samples: u32,
-    lod_bias: f32,
-) -> Vec4 {
+pub fn prefilter_texel(src: &[Vec4], layout: CubeLayout, face: u32, x: u32, y: u32, dst_size: u32, roughness: f32, samples: u32, lod_bias: f32) -> Vec4 {
     if roughness <= 0.0 {
         if let Some(t) = mirror_texel(src, layout, face, x, y, dst_size) {
             return t;

@@ -44,10 +44,7 @@ pub fn orthonormal_basis(n: Vec3) -> (Vec3, Vec3) {
     let sign = if n.z >= 0.0 { 1.0 } else { -1.0 };
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
-    (
-        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        Vec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
+    (Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), Vec3::new(b, sign + n.y * n.y * a, -n.y))
 }
 
 /// A GGX-distributed half vector in tangent space (`z` is the normal), for the unit-square
@@ -95,9 +92,5 @@ pub fn reflect(v: Vec3, h: Vec3) -> Vec3 {
 #[inline]
 pub fn normalize_or(v: Vec3, fallback: Vec3) -> Vec3 {
     let len2 = v.dot(v);
-    if len2 > 1e-30 && len2 <= f32::MAX {
-        v * (1.0 / math::sqrt(len2))
-    } else {
-        fallback
-    }
+    if len2 > 1e-30 && len2 <= f32::MAX { v * (1.0 / math::sqrt(len2)) } else { fallback }
 }

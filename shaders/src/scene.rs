@@ -92,11 +92,7 @@ pub fn camera_ray(frame: &Frame, px: Vec2) -> Vec3 {
 /// plane `z = 0` (row 0 at the top).
 #[inline]
 pub fn sphere_centre(row: u32, col: u32, rows: u32, cols: u32) -> Vec3 {
-    Vec3::new(
-        (col as f32 - 0.5 * (cols as f32 - 1.0)) * GRID_SPACING,
-        (0.5 * (rows as f32 - 1.0) - row as f32) * GRID_SPACING,
-        0.0,
-    )
+    Vec3::new((col as f32 - 0.5 * (cols as f32 - 1.0)) * GRID_SPACING, (0.5 * (rows as f32 - 1.0) - row as f32) * GRID_SPACING, 0.0)
 }
 
 /// The nearest sphere hit along the ray: `(t, row, col)`, `t < 0` if none.

@@ -137,11 +137,7 @@ impl Material {
 /// Fresnel at `cos_theta` in the chosen form.
 #[inline]
 pub fn fresnel(form: u32, f0: Vec3, cos_theta: f32) -> Vec3 {
-    if form == fresnel_model::SPHERICAL_GAUSSIAN {
-        fresnel::spherical_gaussian3(f0, cos_theta)
-    } else {
-        fresnel::schlick3(f0, cos_theta)
-    }
+    if form == fresnel_model::SPHERICAL_GAUSSIAN { fresnel::spherical_gaussian3(f0, cos_theta) } else { fresnel::schlick3(f0, cos_theta) }
 }
 
 /// The roughness-aware Fresnel of the ambient term in the chosen form.
@@ -230,15 +226,7 @@ pub struct EnvironmentShape {
 }
 
 /// Reads the three baked products for normal `n`, view `v` and `roughness`.
-pub fn ibl_sample(
-    shape: EnvironmentShape,
-    specular: &[Vec4],
-    irradiance: &[Vec4],
-    table: &[Vec2],
-    n: Vec3,
-    v: Vec3,
-    roughness: f32,
-) -> IblSample {
+pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], n: Vec3, v: Vec3, roughness: f32) -> IblSample {
     let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
     let r = sampling::reflect(v, n);
     let spec_layout = CubeLayout::new(shape.specular_size, shape.specular_levels);

@@ -77,11 +77,7 @@ fn torus() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 4]>, Vec<[f32; 2]>, Vec<u
             // Tangent along +s (increasing u), bitangent along +t (increasing v).
             let tan = [-su, 0.0, cu];
             let bit = [-sv * cu, cv, -sv * su];
-            let cross = [
-                normal[1] * tan[2] - normal[2] * tan[1],
-                normal[2] * tan[0] - normal[0] * tan[2],
-                normal[0] * tan[1] - normal[1] * tan[0],
-            ];
+            let cross = [normal[1] * tan[2] - normal[2] * tan[1], normal[2] * tan[0] - normal[0] * tan[2], normal[0] * tan[1] - normal[1] * tan[0]];
             let w = if cross[0] * bit[0] + cross[1] * bit[1] + cross[2] * bit[2] < 0.0 { -1.0 } else { 1.0 };
             t.push([tan[0], tan[1], tan[2], w]);
             uv.push([3.0 * i as f32 / nu as f32, j as f32 / nv as f32]);
