@@ -382,6 +382,11 @@ fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
     assert_eq!((h.pixel_width, h.face_count, h.level_count), (8, 6, 3));
     let r: Vec<f64> = plan_json["specular_roughness_per_mip"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
     assert!(r.iter().zip([0.4, 0.6, 0.8]).all(|(a, b)| (a - b).abs() < 1e-6), "{r:?}");
+    // The scene sets the quality: a quality flag beside --scene is refused, not ignored.
+    let mut with_flag = args.to_vec();
+    with_flag.extend(["--samples", "64"]);
+    let e = runner::cli::run(with_flag).expect_err("--samples with --scene");
+    assert!(format!("{e:#}").contains("[quality]"), "{e:#}");
     let entries = std::fs::read_dir(&cache).unwrap().count();
     runner::cli::run(args).expect("second bake");
     assert_eq!(std::fs::read_dir(&cache).unwrap().count(), entries, "no new cache entry");

@@ -41,7 +41,8 @@ enum Command {
 /// How a scene's bake is found or made.
 #[derive(Args, Clone)]
 pub struct SceneArgs {
-    /// A scene file (TOML): bake only what it needs, from the cache when unchanged.
+    /// A scene file (TOML): bake only what it needs, from the cache when unchanged. The
+    /// scene sets the environment, quality, camera, models, lights and output size.
     #[arg(long)]
     pub scene: Option<PathBuf>,
     /// Bake again even if the cache holds this bake.
@@ -237,10 +238,7 @@ impl DisplayBakeArgs {
     /// (a quarter of an equirect's width, up to 1024), the rest from the flags.
     pub fn settings(&self, env: &environment::Environment) -> Settings {
         let mips = CubeLayout::full_chain(self.size.max(1)).saturating_sub(3).max(1);
-        let native = match env {
-            environment::Environment::Equirect(e) => (e.width / 4).max(1).next_power_of_two().min(1024),
-            environment::Environment::Cube(c) => c.layout.size.min(1024),
-        };
+        let native = crate::plan::native_face_size(env);
         Settings { size: self.size, source_size: native.max(self.size), mips, samples: self.samples, lut_size: 128, lut_samples: 512, ..Settings::default() }
     }
 }
@@ -434,6 +432,10 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
 fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
     if let Some(scene_path) = &args.scene.scene {
         anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        anyhow::ensure!(
+            args.quality.settings() == Settings { format: args.quality.format, ..Settings::default() } && !args.sanitize,
+            "with --scene, the bake settings come from the scene's [quality] table (and `sanitize = true`): drop the quality flags"
+        );
         std::fs::create_dir_all(&args.out).map_err(|e| crate::Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
         files::check_writable(&args.out.join("bake.json"))?;
         let backend = Backend::open(args.backend)?;
@@ -543,6 +545,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     files::check_writable(&args.out)?;
     if let Some(scene_path) = &args.scene.scene {
         anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        anyhow::ensure!(
+            (args.width, args.height, args.bake.size, args.bake.samples, args.bake.sanitize) == (960, 540, 128, 256, false),
+            "with --scene, the size comes from the scene's [output] and the bake from its [quality]: drop --width, --height, --size, --samples, --sanitize"
+        );
         let backend = Backend::open(args.backend)?;
         let (scene, sb) = args.scene.bake(scene_path, &backend)?;
         let view = scene.view(sb.env.auto_exposure());
