@@ -126,6 +126,9 @@ fn gpu_matches_cpu() {
         let rel = max_relative(&g.texels, &c.texels, 1e-3);
         let abs = g.texels.iter().zip(&c.texels).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
         println!("{name}: prefilter gpu vs cpu, 32² × 4 mips × 256 samples: max relative {rel:.2e}, max absolute {abs:.2e}");
-        assert!(rel < 1e-5, "{name}: {rel:e}");
+        // lavapipe 1.1e-6; an H100 1.7e-5 (city.exr), its division, square root and fused
+        // multiply–adds differing from the CPU's (see `support::gpu_bound`).
+        let bound = support::gpu_bound(1e-5, 5e-5) as f32;
+        assert!(rel < bound, "{name}: {rel:e} (bound {bound:e})");
     }
 }

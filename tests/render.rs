@@ -72,5 +72,9 @@ fn gpu_matches_the_cpu_reference() {
         "scene 96×64, all {} model combinations: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)",
         diffuse_model::COUNT * specular_model::COUNT * fresnel_model::COUNT
     );
-    assert!(worst_all < 1e-5, "{worst_all:e}");
+    // lavapipe 2.4e-7; an H100 5.4e-5 (sphere silhouettes, where shading is steep in the
+    // hit point; see `support::gpu_bound`), 1.4e-3 before the ray–sphere discriminant was
+    // made cancellation-free.
+    let bound = support::gpu_bound(1e-5, 2e-4) as f32;
+    assert!(worst_all < bound, "{worst_all:e} (bound {bound:e})");
 }

@@ -209,6 +209,11 @@ impl Gpu {
         format!("{} ({:?}, {} {})", self.info.name, self.info.device_type, self.info.driver, self.info.driver_info)
     }
 
+    /// Whether the adapter is a software rasteriser on the CPU (lavapipe, SwiftShader).
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
     /// A storage buffer holding `data`.
     pub fn upload(&self, label: &str, data: &[u8]) -> wgpu::Buffer {
         self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

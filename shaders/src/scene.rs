@@ -106,10 +106,15 @@ pub fn hit_grid(frame: &Frame, origin: Vec3, dir: Vec3) -> (f32, u32, u32) {
     while row < rows {
         let mut col = 0;
         while col < cols {
+            // Haines et al., "Precision Improvements for Ray/Sphere Intersection" (Ray
+            // Tracing Gems, 2019, ch. 7): the discriminant as `R² − |f − (f·d)d|²`, the
+            // squared distance of the centre from the ray, instead of `b² − c`, whose two
+            // terms (≈ |f|², the camera's distance squared) cancel. Without it, whether a
+            // GPU fuses `b·b − c` into an FMA moved edge pixels by 1e-3 on an H100.
             let oc = origin - sphere_centre(row, col, rows, cols);
             let b = oc.dot(dir);
-            let c = oc.dot(oc) - SPHERE_RADIUS * SPHERE_RADIUS;
-            let disc = b * b - c;
+            let perp = oc - dir * b;
+            let disc = SPHERE_RADIUS * SPHERE_RADIUS - perp.dot(perp);
             if disc >= 0.0 {
                 let t = -b - math::sqrt(disc);
                 if t > 0.0 && (best < 0.0 || t < best) {

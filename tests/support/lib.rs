@@ -20,6 +20,26 @@ pub fn gpu() -> &'static Backend {
     })
 }
 
+/// Whether the GPU backend runs on a software Vulkan driver (lavapipe, in CI): LLVM with
+/// correctly rounded division and square root and no fused multiply–add contraction, so
+/// its results follow the CPU's closely.
+pub fn gpu_is_software() -> bool {
+    match gpu() {
+        Backend::Gpu(g) => g.is_software(),
+        Backend::Cpu => unreachable!("opened as a GPU"),
+    }
+}
+
+/// A GPU-vs-CPU bound: `software` on a software driver, `hardware` on a real GPU, where the
+/// Vulkan specification ("Precision and Operation of SPIR-V Instructions") lets division
+/// be off by 2.5 ULP and square root by about 3, and lets `a·b + c` be fused into one
+/// rounding unless the SPIR-V says NoContraction (rust-gpu never does). The hardware bounds
+/// were measured on an NVIDIA H100 (driver 580.159) with a margin; each test names its
+/// figures.
+pub fn gpu_bound(software: f64, hardware: f64) -> f64 {
+    if gpu_is_software() { software } else { hardware }
+}
+
 /// Distance in units in the last place between two finite f32 of the same sign, or across
 /// zero (the count of representable floats between them).
 pub fn ulp_diff(a: f32, b: f32) -> u64 {
