@@ -86,5 +86,8 @@ fn gpu_matches_cpu_on_a_real_environment() {
         worst = worst.max(((*a - *b).abs() / b.abs().max(Vec4::splat(1e-3))).max_element());
     }
     println!("city.exr → 64² cube with mips, gpu vs cpu: max relative difference {worst:.2e}");
-    assert!(worst < 1e-5, "{worst:e}");
+    // lavapipe 3.4e-7; an H100 5.8e-5 (its division, square root and fused multiply–adds;
+    // see `support::gpu_bound`).
+    let bound = support::gpu_bound(1e-5, 2e-4) as f32;
+    assert!(worst < bound, "{worst:e} (bound {bound:e})");
 }
