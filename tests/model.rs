@@ -2,8 +2,6 @@
 //! texture, and the GPU draws it as the CPU reference rasteriser does.
 
 use runner::Backend;
-use runner::bake::{self, Settings};
-use runner::environment::Environment;
 use runner::render::{GpuModel, GpuScene, ViewState};
 use splitsum_shaders::glam::{Vec3, Vec4};
 use std::path::PathBuf;
@@ -55,19 +53,7 @@ fn loads_with_node_transforms_and_every_texture() {
 /// 8 % of the model's pixels above 2/255, all on texture edges and silhouettes).
 #[test]
 fn gpu_draws_the_model_as_the_cpu_reference() {
-    let settings = Settings {
-        size: 32,
-        source_size: 64,
-        mips: 4,
-        samples: 64,
-        irradiance_size: 8,
-        irradiance_source: 16,
-        lut_size: 32,
-        lut_samples: 64,
-        ..Settings::default()
-    };
-    let env = Environment::Equirect(support::environment("courtyard"));
-    let baked = bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();
+    let baked = support::small_display_bake();
     let mut model = runner::model::load(&sample_path()).unwrap();
     model.fit(Vec3::new(0.0, 0.0, 1.5), 4.0);
     let Backend::Gpu(gpu) = support::gpu() else { unreachable!() };

@@ -2,28 +2,9 @@
 //! same `scene::pixel` per pixel.
 
 use runner::Backend;
-use runner::bake::{self, Settings};
-use runner::environment::Environment;
-use runner::render::{BakedEnvironment, GpuScene, ViewState, render_cpu};
+use runner::render::{GpuScene, ViewState, render_cpu};
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
-
-fn small_bake() -> BakedEnvironment {
-    let settings = Settings {
-        size: 32,
-        source_size: 64,
-        mips: 4,
-        samples: 64,
-        irradiance_size: 8,
-        irradiance_source: 16,
-        sh_source: 16,
-        lut_size: 32,
-        lut_samples: 64,
-        ..Settings::default()
-    };
-    let env = Environment::Equirect(support::environment("courtyard"));
-    bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap()
-}
 
 fn diff(a: &[Vec4], b: &[Vec4]) -> (f32, usize) {
     let mut worst = 0.0f32;
@@ -44,7 +25,7 @@ fn diff(a: &[Vec4], b: &[Vec4]) -> (f32, usize) {
 /// so only float rounding differs.
 #[test]
 fn gpu_matches_the_cpu_reference() {
-    let env = small_bake();
+    let env = support::small_display_bake();
     let gpu = match support::gpu() {
         Backend::Gpu(g) => g,
         Backend::Cpu => unreachable!(),

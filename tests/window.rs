@@ -1,9 +1,6 @@
 //! A windowed smoke test: the viewer opens a real window on an X server (Xvfb, with
 //! lavapipe presenting), and a screenshot of the screen shows the rendered scene.
 
-use runner::Backend;
-use runner::bake::{self, Settings};
-use runner::environment::Environment;
 use runner::render::{GpuScene, ViewState};
 use std::process::{Child, Command};
 use std::sync::{Arc, Mutex};
@@ -67,19 +64,7 @@ fn the_viewer_window_shows_the_scene() {
     let (_xvfb, display) = start_xvfb();
     // SAFETY: this test binary runs this one test; nothing else reads the environment now.
     unsafe { std::env::set_var("DISPLAY", &display) };
-    let settings = Settings {
-        size: 32,
-        source_size: 64,
-        mips: 4,
-        samples: 64,
-        irradiance_size: 8,
-        irradiance_source: 16,
-        lut_size: 32,
-        lut_samples: 64,
-        ..Settings::default()
-    };
-    let env = Environment::Equirect(support::environment("courtyard"));
-    let baked = bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();
+    let baked = support::small_display_bake();
     let (w, h) = (320u32, 200u32);
     let state = ViewState { exposure: baked.auto_exposure(), ..ViewState::default() };
 

@@ -245,30 +245,18 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     let lod_of = |r: f32| mapping.lod(r, mips);
 
     // Specular mips.
-    let mut levels: Vec<u32> = Vec::new();
-    let add_range = |lo: f32, hi: f32, levels: &mut Vec<u32>| {
-        let a = lod_of(lo).floor() as u32;
-        let b = (lod_of(hi).ceil() as u32).min(mips - 1);
-        for l in a..=b {
-            if !levels.contains(&l) {
-                levels.push(l);
-            }
-        }
-    };
+    // The mips that trilinear lookups at levels of detail `lo ..= hi` read.
+    let mut read = std::collections::BTreeSet::new();
+    let mut add_lods = |lo: f32, hi: f32| read.extend(lo.floor() as u32..=(hi.ceil() as u32).min(mips - 1));
     for m in &specular_ibl {
         let (a, b) = m.roughness.range();
-        add_range(a, b, &mut levels);
+        add_lods(lod_of(a), lod_of(b));
     }
     if scene.sky_blur > 0.0 {
         let b = scene.sky_blur.min((mips - 1) as f32);
-        let (lo, hi) = (b.floor() as u32, (b.ceil() as u32).min(mips - 1));
-        for l in lo..=hi {
-            if !levels.contains(&l) {
-                levels.push(l);
-            }
-        }
+        add_lods(b, b);
     }
-    levels.sort();
+    let levels: Vec<u32> = read.into_iter().collect();
 
     let specular = !levels.is_empty();
     if lit.is_empty() {

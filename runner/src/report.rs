@@ -178,9 +178,13 @@ fn timed<T>(f: impl FnOnce() -> Result<T>) -> Result<(T, f64)> {
     Ok((v, start.elapsed().as_secs_f64() * 1e3))
 }
 
-fn mean_max(errors: &[f64]) -> (f64, f64) {
-    let mean = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
-    (mean, errors.iter().copied().fold(0.0, f64::max))
+impl Measurement {
+    /// A row from its `errors`: their mean and largest.
+    fn of(product: impl Into<String>, backend: impl Into<String>, setting: impl Into<String>, time_ms: f64, errors: &[f64], metric: &'static str) -> Self {
+        let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
+        let max_error = errors.iter().copied().fold(0.0, f64::max);
+        Self { product: product.into(), backend: backend.into(), setting: setting.into(), time_ms, mean_error, max_error, metric }
+    }
 }
 
 fn rel(got: Vec3, want: [f64; 3]) -> f64 {
@@ -313,16 +317,7 @@ impl References {
             .iter()
             .map(|&(label, lo, hi)| {
                 let errors: Vec<f64> = self.shading.iter().filter(|p| in_view(p, lo, hi)).map(|p| rel(p.exact_split, p.full)).collect();
-                let (mean, max) = mean_max(&errors);
-                Measurement {
-                    product: format!("shaded colour {label}: split-sum approximation"),
-                    backend: "exact ingredients".into(),
-                    setting: "n = v = r, split".into(),
-                    time_ms: f64::NAN,
-                    mean_error: mean,
-                    max_error: max,
-                    metric: REL,
-                }
+                Measurement::of(format!("shaded colour {label}: split-sum approximation"), "exact ingredients", "n = v = r, split", f64::NAN, &errors, REL)
             })
             .collect()
     }
@@ -333,31 +328,13 @@ fn lut_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References) -> Res
     for &n in &sweep.samples {
         let (table, ms) = timed(|| backend.brdf_lut(sweep.lut_size, n))?;
         let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
-        let (mean, max) = mean_max(&errors);
-        rows.push(Measurement {
-            product: "brdf lut".into(),
-            backend: b.into(),
-            setting: format!("{n} samples"),
-            time_ms: ms,
-            mean_error: mean,
-            max_error: max,
-            metric: ABS,
-        });
+        rows.push(Measurement::of("brdf lut", b, format!("{n} samples"), ms, &errors, ABS));
     }
     let n = *sweep.samples.last().expect("samples");
     for &size in &sweep.lut_sizes {
         let (table, ms) = timed(|| backend.brdf_lut(size, n))?;
         let errors: Vec<f64> = refs.lut_points.iter().map(|(p, r)| (lut::sample(&table.texels, size, p.x, p.y) - *r).abs().max_element() as f64).collect();
-        let (mean, max) = mean_max(&errors);
-        rows.push(Measurement {
-            product: "brdf lut lookup".into(),
-            backend: b.into(),
-            setting: format!("{size}x{size} at {n} samples"),
-            time_ms: ms,
-            mean_error: mean,
-            max_error: max,
-            metric: ABS,
-        });
+        rows.push(Measurement::of("brdf lut lookup", b, format!("{size}x{size} at {n} samples"), ms, &errors, ABS));
     }
     Ok(rows)
 }
@@ -374,8 +351,7 @@ fn prefilter_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, 
             .zip(&refs.prefilter[m])
             .map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, layout, 0, d).truncate(), *r))
             .collect();
-        let (mean, max) = mean_max(&errors);
-        rows.push(Measurement { product, backend: b.into(), setting, time_ms: ms, mean_error: mean, max_error: max, metric: REL });
+        rows.push(Measurement::of(product, b, setting, ms, &errors, REL));
         Ok(())
     };
     let default_bias = Settings::default().lod_bias;
@@ -408,32 +384,14 @@ fn irradiance_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References,
             .zip(&refs.irradiance)
             .map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, cube.layout, 0, d).truncate(), *r))
             .collect();
-        let (mean, max) = mean_max(&errors);
-        rows.push(Measurement {
-            product: "irradiance (convolution)".into(),
-            backend: b.into(),
-            setting: format!("{s}x{s} source"),
-            time_ms: ms,
-            mean_error: mean,
-            max_error: max,
-            metric: REL,
-        });
+        rows.push(Measurement::of("irradiance (convolution)", b, format!("{s}x{s} source"), ms, &errors, REL));
     }
     for &s in &sweep.sh_sources {
         let level = bake::level_of_size(source.layout, s);
         let (sh, ms) = timed(|| backend.sh9(source, level))?;
         let coeffs = sh.as_vec4();
         let errors: Vec<f64> = refs.irradiance_dirs.iter().zip(&refs.irradiance).map(|(&d, r)| rel(sh9_irradiance(&coeffs, d), *r)).collect();
-        let (mean, max) = mean_max(&errors);
-        rows.push(Measurement {
-            product: "irradiance (SH9)".into(),
-            backend: b.into(),
-            setting: format!("{s}x{s} source"),
-            time_ms: ms,
-            mean_error: mean,
-            max_error: max,
-            metric: REL,
-        });
+        rows.push(Measurement::of("irradiance (SH9)", b, format!("{s}x{s} source"), ms, &errors, REL));
     }
     Ok(rows)
 }
@@ -464,16 +422,7 @@ fn shaded_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, env
                     rel(shade::ibl(ShadeOptions::DEFAULT, &p.material, p.n, p.v, s), p.full)
                 })
                 .collect();
-            let (mean, max) = mean_max(&errors);
-            rows.push(Measurement {
-                product: format!("shaded colour {view}"),
-                backend: b.into(),
-                setting: label.clone(),
-                time_ms: ms,
-                mean_error: mean,
-                max_error: max,
-                metric: REL,
-            });
+            rows.push(Measurement::of(format!("shaded colour {view}"), b, label.clone(), ms, &errors, REL));
         }
     }
     Ok(rows)

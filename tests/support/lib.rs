@@ -78,6 +78,25 @@ pub fn source_cube(name: &str, size: u32) -> runner::texture::Cube {
     Backend::Cpu.equirect_to_cube(&e, size, n).expect("cpu bake")
 }
 
+/// A small, quick bake of the courtyard for the display tests (32² specular cube with 4
+/// mips at 64 samples, 8² irradiance, 32² table), on the CPU.
+pub fn small_display_bake() -> runner::render::BakedEnvironment {
+    let settings = runner::bake::Settings {
+        size: 32,
+        source_size: 64,
+        mips: 4,
+        samples: 64,
+        irradiance_size: 8,
+        irradiance_source: 16,
+        sh_source: 16,
+        lut_size: 32,
+        lut_samples: 64,
+        ..runner::bake::Settings::default()
+    };
+    let env = runner::environment::Environment::Equirect(environment("courtyard"));
+    runner::bake::bake_for_display(&Backend::Cpu, &env, &settings).expect("cpu bake")
+}
+
 /// A cube with full mips whose level 0 is `f(direction)` at the texel centres.
 pub fn cube_from_fn(size: u32, f: impl Fn(splitsum_shaders::glam::Vec3) -> splitsum_shaders::glam::Vec4) -> runner::texture::Cube {
     use splitsum_shaders::cubemap::{self, CubeLayout};
