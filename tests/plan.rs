@@ -142,12 +142,17 @@ fn a_maximum_error_picks_the_cheapest_settings_that_meet_it() {
     let loose = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.05")));
     let tight = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.002")));
     // Loose, from the built-in table: mips 1 … 5 (r = 0.2 … 1) need ≤ 0.05 at r = ⅓, ⅔
-    // and 1: 256 samples give 0.069 at ⅓, 1024 give at most 0.0275. The table: 16 samples
-    // (0.0198). The irradiance: the 4² level (0.035).
-    assert_eq!((loose.settings.samples, loose.settings.lut_samples, loose.settings.irradiance_source), (1024, 16, 4));
+    // and 1: 256 samples give 0.069 at ⅓, 1024 give at most 0.0275. The irradiance: the 4²
+    // level (0.035). The table is integrated by quadrature (within 1e-5), whatever the target.
+    assert_eq!((loose.settings.samples, loose.settings.irradiance_source), (1024, 4));
+    assert_eq!(loose.settings.lut_method, runner::bake::TableMethod::Quadrature);
     // Tight: no measured count reaches 0.002 at r = 1 (4096 give 0.0154), and the plan
-    // says so; the table needs 1024 (8.9e-4; 256 give 2.6e-3); the irradiance 32² (1.7e-3).
-    assert_eq!((tight.settings.samples, tight.settings.lut_samples, tight.settings.irradiance_source), (4096, 1024, 32));
+    // says so; the irradiance needs 32² (1.7e-3).
+    assert_eq!((tight.settings.samples, tight.settings.irradiance_source), (4096, 32));
+    assert_eq!(tight.settings.lut_method, runner::bake::TableMethod::Quadrature);
+    // A sample count in the scene asks for the sampled table.
+    let sampled = planned(&scene("", &format!("{body}\n[quality]\nlut_samples = 64")));
+    assert_eq!((sampled.settings.lut_method, sampled.settings.lut_samples), (runner::bake::TableMethod::Sampled, 64));
     assert!(tight.decisions.iter().any(|d| d.what == "prefilter samples" && d.why.contains("still above")));
     assert!(tight.cost.cpu_seconds > 2.0 * loose.cost.cpu_seconds);
     // Fixed settings are kept as given.

@@ -18,6 +18,33 @@ fn g_schlick(n_dot_v: f64, n_dot_l: f64, k: f64) -> f64 {
     g1(n_dot_v) * g1(n_dot_l)
 }
 
+/// The masking–shadowing term of a reference integral.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Smith {
+    /// Separable Smith with Schlick's G₁, `k = α/2`.
+    Schlick,
+    /// Height-correlated Smith for GGX in its textbook form
+    /// `G₂ = 1/(1 + Λ(v) + Λ(l))`, `Λ(θ) = (−1 + √(1 + α² tan²θ))/2` (Heitz 2014, eq. 99;
+    /// Walter et al. 2007, eq. 34 for Λ).
+    Correlated,
+}
+
+impl Smith {
+    /// `G(v, l)` at `n·v`, `n·l` for GGX width `alpha`.
+    pub fn g(self, n_dot_v: f64, n_dot_l: f64, alpha: f64) -> f64 {
+        match self {
+            Smith::Schlick => g_schlick(n_dot_v, n_dot_l, alpha / 2.0),
+            Smith::Correlated => {
+                let lambda = |c: f64| {
+                    let tan2 = (1.0 - c * c) / (c * c);
+                    (-1.0 + (1.0 + alpha * alpha * tan2).sqrt()) / 2.0
+                };
+                1.0 / (1.0 + lambda(n_dot_v) + lambda(n_dot_l))
+            }
+        }
+    }
+}
+
 /// Split-sum `(A, B)` at `(n·v, roughness)` by nested adaptive Gauss–Kronrod quadrature over
 /// the half vector, in the substitution `tan θ_h = α tan x`, where GGX's peak flattens:
 /// `D(h)(n·h) dω_h = (1/π) sin x cos x dx dφ`. With `dω_l = 4(v·h) dω_h`,
@@ -28,14 +55,18 @@ fn g_schlick(n_dot_v: f64, n_dot_l: f64, k: f64) -> f64 {
 /// form), doubled by the symmetry about the plane of `n` and `v`; `tol` is the absolute
 /// tolerance of each integral.
 pub fn brdf_lut(n_dot_v: f64, roughness: f64, tol: f64) -> (f64, f64) {
-    let a = brdf_lut_part(n_dot_v, roughness, tol, false);
-    let b = brdf_lut_part(n_dot_v, roughness, tol, true);
+    brdf_lut_with(n_dot_v, roughness, tol, Smith::Schlick)
+}
+
+/// [`brdf_lut`] with the masking–shadowing term `smith`.
+pub fn brdf_lut_with(n_dot_v: f64, roughness: f64, tol: f64, smith: Smith) -> (f64, f64) {
+    let a = brdf_lut_part(n_dot_v, roughness, tol, false, smith);
+    let b = brdf_lut_part(n_dot_v, roughness, tol, true, smith);
     (a, b)
 }
 
-fn brdf_lut_part(n_dot_v: f64, roughness: f64, tol: f64, bias: bool) -> f64 {
+fn brdf_lut_part(n_dot_v: f64, roughness: f64, tol: f64, bias: bool, smith: Smith) -> f64 {
     let alpha = roughness * roughness;
-    let k = alpha / 2.0;
     let sin_v = (1.0 - n_dot_v * n_dot_v).sqrt();
     let v = [sin_v, 0.0, n_dot_v];
     let outer = |x: f64| -> f64 {
@@ -58,7 +89,7 @@ fn brdf_lut_part(n_dot_v: f64, roughness: f64, tol: f64, bias: bool) -> f64 {
             if n_dot_l <= 0.0 || v_dot_h <= 0.0 {
                 return 0.0;
             }
-            let g = g_schlick(n_dot_v, n_dot_l, k);
+            let g = smith.g(n_dot_v, n_dot_l, alpha);
             let vis = g * v_dot_h / (ct * n_dot_v);
             let fc = (1.0 - v_dot_h).powi(5);
             vis * if bias { fc } else { 1.0 - fc }
@@ -196,4 +227,160 @@ pub fn shade_full(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3], v: [f64; 3]
 /// Rec. 709 luminance.
 pub fn luminance(c: [f64; 3]) -> f64 {
     0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+/// One texel of a cube level as the sub-sampled references see it.
+#[derive(Clone, Copy, Debug)]
+pub struct Texel {
+    /// Face (OpenGL order).
+    pub face: u32,
+    /// Column.
+    pub x: u32,
+    /// Row.
+    pub y: u32,
+    /// Unit direction through its centre.
+    pub dir: [f64; 3],
+    /// Its solid angle.
+    pub omega: f64,
+    /// Its radiance.
+    pub rgb: [f64; 3],
+}
+
+/// A cube level as a piecewise-constant radiance function: every texel is a patch of the
+/// sphere with one value. [`Environment::integrate`] sums a weight over it, splitting a
+/// texel into `k×k` sub-patches (exact solid angles, by Driscoll's corner formula) where
+/// the weight varies on a scale smaller than the texel, so that lobes narrower than a
+/// texel are integrated, not point-sampled.
+pub struct Environment {
+    /// Face size.
+    pub size: u32,
+    /// Every texel.
+    pub texels: Vec<Texel>,
+}
+
+/// The direction through face coordinates `(a, b)` ∈ [−1, 1]² of `face` (OpenGL 4.6
+/// §8.13, inverted by hand; the same table as [`texel_dir`]).
+fn face_dir(face: u32, a: f64, b: f64) -> [f64; 3] {
+    normalize(match face {
+        0 => [1.0, -b, -a],
+        1 => [-1.0, -b, a],
+        2 => [a, 1.0, b],
+        3 => [a, -1.0, -b],
+        4 => [a, -b, 1.0],
+        _ => [-a, -b, -1.0],
+    })
+}
+
+/// Solid angle of the face rectangle `[a0, a1] × [b0, b1]` (Driscoll 2012).
+fn rect_solid_angle(a0: f64, a1: f64, b0: f64, b1: f64) -> f64 {
+    let f = |u: f64, v: f64| (u * v).atan2((u * u + v * v + 1.0).sqrt());
+    f(a0, b0) - f(a0, b1) - f(a1, b0) + f(a1, b1)
+}
+
+impl Environment {
+    /// The level `level` (`s`×`s` faces, RGBA) of a cube.
+    pub fn new(level: &[splitsum_shaders::glam::Vec4], s: u32) -> Self {
+        let mut texels = Vec::with_capacity(level.len());
+        for face in 0..6 {
+            for y in 0..s {
+                for x in 0..s {
+                    let t = level[((face * s + y) * s + x) as usize];
+                    let rgb = [t.x as f64, t.y as f64, t.z as f64];
+                    texels.push(Texel { face, x, y, dir: texel_dir(face, x, y, s), omega: texel_solid_angle(x, y, s), rgb });
+                }
+            }
+        }
+        Self { size: s, texels }
+    }
+
+    /// The brightest texel's direction (by luminance).
+    pub fn brightest(&self) -> [f64; 3] {
+        self.texels.iter().max_by(|a, b| luminance(a.rgb).total_cmp(&luminance(b.rgb))).map_or([0.0, 0.0, 1.0], |t| t.dir)
+    }
+
+    /// `Σ L(l) w(l) dω` over the sphere and `Σ w(l) dω`, per channel, for a weight `w`
+    /// (one per channel) whose angular scale of variation at `l` is `scale(l)` radians: a
+    /// texel of angular size `√Ω` is split into `k = ⌈2√Ω/scale⌉` (at most 64) sub-patches
+    /// per side.
+    pub fn integrate(&self, w: impl Fn([f64; 3]) -> [f64; 3], scale: impl Fn([f64; 3]) -> f64) -> ([f64; 3], [f64; 3]) {
+        let mut acc = [0.0; 3];
+        let mut wsum = [0.0; 3];
+        let s = self.size as f64;
+        for t in &self.texels {
+            let k = ((2.0 * t.omega.sqrt() / scale(t.dir).max(1e-12)).ceil() as u32).clamp(1, 64);
+            let mut tw = [0.0; 3];
+            if k == 1 {
+                tw = w(t.dir).map(|x| x * t.omega);
+            } else {
+                let d = 2.0 / s;
+                let (a0, b0) = (t.x as f64 * d - 1.0, t.y as f64 * d - 1.0);
+                let h = d / k as f64;
+                for j in 0..k {
+                    for i in 0..k {
+                        let (a, b) = (a0 + i as f64 * h, b0 + j as f64 * h);
+                        let dir = face_dir(t.face, a + 0.5 * h, b + 0.5 * h);
+                        let om = rect_solid_angle(a, a + h, b, b + h).abs();
+                        let wd = w(dir);
+                        for c in 0..3 {
+                            tw[c] += wd[c] * om;
+                        }
+                    }
+                }
+            }
+            for c in 0..3 {
+                acc[c] += tw[c] * t.rgb[c];
+                wsum[c] += tw[c];
+            }
+        }
+        (acc, wsum)
+    }
+
+    /// GGX-prefiltered radiance with `n = v = r` (see [`prefilter`]), sub-sampled where the
+    /// lobe is narrower than a texel.
+    pub fn prefilter(&self, n: [f64; 3], roughness: f64) -> [f64; 3] {
+        let alpha = roughness * roughness;
+        let a2 = alpha * alpha;
+        let half = |l: [f64; 3]| normalize([n[0] + l[0], n[1] + l[1], n[2] + l[2]]);
+        let w = |l: [f64; 3]| {
+            let nl = dot(n, l);
+            if nl <= 0.0 {
+                return 0.0;
+            }
+            let nh = dot(n, half(l));
+            a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2)) * nl
+        };
+        let scale = |l: [f64; 3]| 2.0 * alpha.max(dot(n, half(l)).clamp(-1.0, 1.0).acos());
+        let (acc, wsum) = self.integrate(|l| [w(l); 3], scale);
+        if wsum[0] > 0.0 { acc.map(|v| v / wsum[0]) } else { [0.0; 3] }
+    }
+
+    /// Reflected radiance towards `v` of a glTF metallic–roughness surface by the full
+    /// reflectance integral with no split, as [`shade_full`] but with the masking term
+    /// `smith` and sub-sampled where the specular lobe is narrower than a texel.
+    #[allow(clippy::too_many_arguments)]
+    pub fn shade(&self, n: [f64; 3], v: [f64; 3], base: [f64; 3], metallic: f64, roughness: f64, smith: Smith) -> [f64; 3] {
+        let alpha = roughness * roughness;
+        let a2 = alpha * alpha;
+        let nv = dot(n, v);
+        let f0: [f64; 3] = std::array::from_fn(|c| 0.04 + (base[c] - 0.04) * metallic);
+        let half = |l: [f64; 3]| normalize([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
+        let scale = |l: [f64; 3]| 2.0 * alpha.max(dot(n, half(l)).clamp(-1.0, 1.0).acos());
+        let w = |l: [f64; 3]| {
+            let nl = dot(n, l);
+            if nl <= 0.0 || nv <= 0.0 {
+                return [0.0; 3];
+            }
+            let h = half(l);
+            let nh = dot(n, h);
+            let vh = dot(v, h).max(0.0);
+            let d = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
+            let g = smith.g(nv, nl, alpha);
+            let fc = (1.0 - vh).powi(5);
+            std::array::from_fn(|c| {
+                let f = f0[c] + (1.0 - f0[c]) * fc;
+                ((1.0 - f) * (1.0 - metallic) * base[c] / PI + d * g * f / (4.0 * nl * nv)) * nl
+            })
+        };
+        self.integrate(w, scale).0
+    }
 }

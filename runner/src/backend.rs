@@ -13,7 +13,8 @@ use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
-use splitsum_shaders::kernels::{self, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, probe_mode};
+use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::kernels::{self, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, TableParams, probe_mode};
 use splitsum_shaders::math::{CHUNK, MeanPartial};
 use splitsum_shaders::{equirect, lut, prefilter};
 
@@ -110,6 +111,37 @@ impl Backend {
         }
         let sums = read_vec4(g, &accum, n as u32)?;
         Ok(Lut { size, texels: sums.iter().map(|&st| lut::resolve(st, samples)).collect() })
+    }
+
+    /// The `size`×`size` BRDF table by deterministic quadrature with `masking`
+    /// (`lut::integrate_brdf_quadrature`).
+    pub fn brdf_table(&self, size: u32, masking: Masking) -> Result<Lut> {
+        check_lut_args(size, 1)?;
+        let g = match self {
+            Backend::Cpu => return Ok(cpu::brdf_table(size, masking)),
+            Backend::Gpu(g) => g,
+        };
+        let n = size as u64 * size as u64;
+        let out = g.output("brdf table", n * 16)?;
+        // Rows per submission: about 2²⁶ integrand evaluations (some 550 per texel), so
+        // that no submission runs long enough to trip a display driver's watchdog.
+        let rows = ((1u64 << 26) / (size as u64 * 512)).clamp(1, size as u64) as u32;
+        let rows = rows.div_ceil(kernels::TILE) * kernels::TILE;
+        let mut row = 0;
+        while row < size {
+            let p = TableParams { size, masking: masking as u32, row_offset: row, pad: 0 };
+            let h = rows.min(size - row);
+            g.run(&[Dispatch {
+                kernel: Kernel::BrdfTable,
+                params: bytemuck::bytes_of(&p),
+                input: None,
+                output: &out,
+                groups: [gpu::groups(size, kernels::TILE), gpu::groups(h, kernels::TILE), 1],
+            }]);
+            row += h;
+        }
+        let texels = read_vec4(g, &out, n as u32)?;
+        Ok(Lut { size, texels: texels.iter().map(|t| t.truncate().truncate()).collect() })
     }
 
     /// The source cube: `env` resampled to faces of `size` with `supersample`² points per

@@ -1,6 +1,6 @@
 //! The command line: parsing with clap, then orchestration of backends and files.
 
-use crate::bake::{self, Mapping, Products, Settings};
+use crate::bake::{self, Mapping, MaskingModel, Products, Settings, TableMethod};
 use crate::environment;
 use crate::files;
 use crate::ktx2::Format;
@@ -305,9 +305,15 @@ pub struct QualityArgs {
     /// Width and height of the BRDF table.
     #[arg(long, default_value_t = 256)]
     pub lut_size: u32,
-    /// Samples per texel of the BRDF table.
+    /// Samples per texel of the BRDF table (with --lut-method sampled).
     #[arg(long, default_value_t = 1024)]
     pub lut_samples: u32,
+    /// How the BRDF table is integrated: deterministic quadrature (within 1e-5) or sampling.
+    #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
+    pub lut_method: TableMethod,
+    /// The table's masking–shadowing term.
+    #[arg(long, value_enum, default_value_t = MaskingModel::Schlick)]
+    pub lut_masking: MaskingModel,
     /// KTX2 texel format; auto = RGBA16F unless a value exceeds 65504, then RGBA32F.
     #[arg(long, value_enum, default_value_t = Format::Auto)]
     pub format: Format,
@@ -330,6 +336,8 @@ impl QualityArgs {
             sh_source: self.sh_source,
             lut_size: self.lut_size,
             lut_samples: self.lut_samples,
+            lut_method: self.lut_method,
+            lut_masking: self.lut_masking,
             format: self.format,
         }
     }
@@ -376,7 +384,13 @@ struct LutArgs {
     /// Table width and height: column x holds NdotV = (x+0.5)/S, row y roughness = (y+0.5)/S.
     #[arg(long, default_value_t = 256)]
     size: u32,
-    /// Hammersley points per texel.
+    /// Deterministic quadrature (within 1e-5 of the f64 reference) or Hammersley sampling.
+    #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
+    method: TableMethod,
+    /// Masking–shadowing term: Smith–Schlick (k = α/2) or the exact height-correlated Smith.
+    #[arg(long, value_enum, default_value_t = MaskingModel::Schlick)]
+    masking: MaskingModel,
+    /// Hammersley points per texel (with --method sampled).
     #[arg(long, default_value_t = 1024)]
     samples: u32,
     /// Where to bake.
@@ -417,10 +431,21 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     }
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();
-    let lut = backend.brdf_lut(args.size, args.samples)?;
+    let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: args.masking, ..Settings::default() };
+    if args.samples == 0 {
+        anyhow::bail!("--samples must be at least 1");
+    }
+    if settings.lut_method == TableMethod::Sampled && settings.lut_masking != MaskingModel::Schlick {
+        anyhow::bail!("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)");
+    }
+    let lut = bake::brdf_table(&backend, &settings)?;
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
-    println!("brdf lut {}x{} at {} samples/texel on {}: bake {:.3} s", args.size, args.size, args.samples, backend.describe(), secs);
+    let how = match args.method {
+        TableMethod::Quadrature => format!("by quadrature ({:?} masking)", args.masking),
+        TableMethod::Sampled => format!("at {} samples/texel", args.samples),
+    };
+    println!("brdf lut {}x{} {how} on {}: bake {:.3} s", args.size, args.size, backend.describe(), secs);
     println!("wrote {}", args.out.display());
     if let Some(p) = png {
         files::write_png(&p, lut.size, lut.size, &files::lut_preview(&lut))?;

@@ -33,6 +33,20 @@ pub fn brdf_lut(size: u32, samples: u32) -> Lut {
     Lut { size, texels }
 }
 
+/// The BRDF table by quadrature, one rayon task per row.
+pub fn brdf_table(size: u32, masking: splitsum_shaders::brdf::microfacet::Masking) -> Lut {
+    let bar = progress("brdf table", size as u64);
+    let mut texels = vec![Vec2::ZERO; (size * size) as usize];
+    texels.par_chunks_mut(size as usize).enumerate().for_each(|(y, row)| {
+        for (x, t) in row.iter_mut().enumerate() {
+            *t = lut::texel_quadrature(x as u32, y as u32, size, masking);
+        }
+        bar.inc(1);
+    });
+    bar.finish_and_clear();
+    Lut { size, texels }
+}
+
 /// Fills the rows of one cube level, `f(face, x, y)` per texel, in parallel.
 fn fill_level(out: &mut [Vec4], size: u32, bar: &ProgressBar, f: impl Fn(u32, u32, u32) -> Vec4 + Sync) {
     out.par_chunks_mut(size as usize).enumerate().for_each(|(row, texels)| {

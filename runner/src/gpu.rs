@@ -18,6 +18,8 @@ pub static SPIRV: &[u8] = include_bytes!(env!("SPLITSUM_SPV"));
 pub enum Kernel {
     /// `kernels::brdf_lut`.
     BrdfLut,
+    /// `kernels::brdf_table`.
+    BrdfTable,
     /// `kernels::equirect_pyramid`.
     EquirectPyramid,
     /// `kernels::equirect_to_cube`.
@@ -36,8 +38,9 @@ pub enum Kernel {
 
 impl Kernel {
     /// Every kernel.
-    pub const ALL: [Kernel; 8] = [
+    pub const ALL: [Kernel; 9] = [
         Kernel::BrdfLut,
+        Kernel::BrdfTable,
         Kernel::EquirectPyramid,
         Kernel::EquirectToCube,
         Kernel::Downsample,
@@ -51,6 +54,7 @@ impl Kernel {
     pub fn entry_point(self) -> &'static str {
         match self {
             Kernel::BrdfLut => "kernels::brdf_lut",
+            Kernel::BrdfTable => "kernels::brdf_table",
             Kernel::EquirectPyramid => "kernels::equirect_pyramid",
             Kernel::EquirectToCube => "kernels::equirect_to_cube",
             Kernel::Downsample => "kernels::downsample",

@@ -4,6 +4,7 @@
 //! `splitsum_shaders` functions, the files that go in and out, and the orchestration of
 //! bakes. It holds no BRDF or sampling math: that lives once, in `splitsum_shaders`.
 
+pub mod accuracy;
 pub mod backend;
 pub mod bake;
 pub mod cache;

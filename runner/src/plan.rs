@@ -313,15 +313,14 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
         }
         _ => settings.samples,
     };
-    settings.lut_samples = match (q.lut_samples, target) {
-        (Some(n), _) => n,
-        (None, Some(e)) if lut => {
-            let (n, why) = cheapest(&cal.lut, e, |n| n.to_string());
-            decide("BRDF table samples", true, why);
-            n
-        }
-        _ => settings.lut_samples,
-    };
+    // The table: by quadrature (within 1e-5 of the reference, which meets any target)
+    // unless the scene asks for a sample count, which means the sampled (seed) table.
+    if let Some(n) = q.lut_samples {
+        settings.lut_samples = n;
+        settings.lut_method = crate::bake::TableMethod::Sampled;
+    } else if let (Some(e), true) = (target, lut) {
+        decide("BRDF table method", true, format!("quadrature: max error 1e-5 at every texel ≤ {e}"));
+    }
     settings.lut_size = q.lut_size.unwrap_or(settings.lut_size);
     settings.irradiance_source = match (q.irradiance_source, target) {
         (Some(s), _) => s,
@@ -377,7 +376,11 @@ pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, ca
         }
     }
     if products.lut {
-        work[2] = (s.lut_size as f64).powi(2) * s.lut_samples as f64;
+        let per_texel = match s.lut_method {
+            crate::bake::TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
+            crate::bake::TableMethod::Sampled => s.lut_samples,
+        };
+        work[2] = (s.lut_size as f64).powi(2) * per_texel as f64;
         bytes += (s.lut_size as u64).pow(2) * 8;
     }
     if products.irradiance {
@@ -407,7 +410,10 @@ pub fn describe(plan: &Plan, scene: &str, environment: &str) -> String {
         kept.push(format!("specular {}² × {} mips ({:?}), {} samples, bias {}", s.size, s.mips, s.mapping, s.samples, s.lod_bias));
     }
     if p.lut {
-        kept.push(format!("table {}² × {} samples", s.lut_size, s.lut_samples));
+        kept.push(match s.lut_method {
+            crate::bake::TableMethod::Quadrature => format!("table {}² by quadrature", s.lut_size),
+            crate::bake::TableMethod::Sampled => format!("table {}² × {} samples", s.lut_size, s.lut_samples),
+        });
     }
     if p.irradiance {
         kept.push(format!("irradiance {}² from {}²", s.irradiance_size, s.irradiance_source));

@@ -64,6 +64,11 @@ pub struct Sweep {
     pub qualities: Vec<(String, Settings)>,
     /// Probe directions per comparison.
     pub directions: u32,
+    /// Largest face size of the source cube of the end-to-end measure (`accuracy`): the
+    /// environment's own resolution up to this.
+    pub accuracy_source: u32,
+    /// Shading points and prefiltered lookups of the end-to-end measure.
+    pub accuracy_points: (u32, u32),
 }
 
 impl Sweep {
@@ -88,7 +93,30 @@ impl Sweep {
 
     /// A quick report for CI: the same sweeps, smaller and shorter.
     pub fn quick() -> Self {
-        Self::with(16, 8, 8, vec![4, 16, 64], vec![4, 8, 16], vec![16], vec![4, 8], vec![4, 8, 16], vec![4, 8, 16], 8)
+        let mut sweep = Self::with(16, 8, 8, vec![4, 16, 64], vec![4, 8, 16], vec![16], vec![4, 8], vec![4, 8, 16], vec![4, 8, 16], 8);
+        sweep.accuracy_source = 16;
+        sweep.accuracy_points = (48, 48);
+        sweep
+    }
+
+    /// The display methods the end-to-end measure compares, for an environment whose native
+    /// face size is `native`: the seed method, today's defaults, and each shading option.
+    pub fn methods(&self, native: u32) -> Vec<crate::accuracy::Method> {
+        use crate::accuracy::{Method, seed_settings};
+        let src = native.min(self.accuracy_source).max(4);
+        let default = Settings { size: src, source_size: src, ..Settings::default() }.fitted();
+        let flags = ShadeOptions::DEFAULT.flags & !(ShadeOptions::IBL | ShadeOptions::DIRECT);
+        vec![
+            Method { label: "seed (6 linear mips, 1024 samples, sampled table)".into(), settings: seed_settings(src), flags: 0 },
+            Method { label: "defaults".into(), settings: default.clone(), flags },
+            Method { label: "defaults, mirror direction".into(), settings: default.clone(), flags: flags & !ShadeOptions::DOMINANT_DIRECTION },
+            Method { label: "defaults + multiple scattering".into(), settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
+            Method {
+                label: "defaults, exact-Smith table".into(),
+                settings: Settings { lut_masking: crate::bake::MaskingModel::Correlated, ..default },
+                flags,
+            },
+        ]
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -146,6 +174,8 @@ impl Sweep {
             sh_sources,
             qualities,
             directions,
+            accuracy_source: 256,
+            accuracy_points: (512, 512),
         }
     }
 }
@@ -170,7 +200,8 @@ pub struct Measurement {
 }
 
 const ABS: &str = "absolute";
-const REL: &str = "relative luminance";
+/// The metric of radiance errors.
+pub const REL: &str = "relative luminance";
 
 fn timed<T>(f: impl FnOnce() -> Result<T>) -> Result<(T, f64)> {
     let start = Instant::now();
@@ -180,7 +211,7 @@ fn timed<T>(f: impl FnOnce() -> Result<T>) -> Result<(T, f64)> {
 
 impl Measurement {
     /// A row from its `errors`: their mean and largest.
-    fn of(product: impl Into<String>, backend: impl Into<String>, setting: impl Into<String>, time_ms: f64, errors: &[f64], metric: &'static str) -> Self {
+    pub fn of(product: impl Into<String>, backend: impl Into<String>, setting: impl Into<String>, time_ms: f64, errors: &[f64], metric: &'static str) -> Self {
         let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
         let max_error = errors.iter().copied().fold(0.0, f64::max);
         Self { product: product.into(), backend: backend.into(), setting: setting.into(), time_ms, mean_error, max_error, metric }
@@ -224,6 +255,16 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
         rows.extend(prefilter_rows(backend, &b, sweep, &refs, &source)?);
         rows.extend(irradiance_rows(backend, &b, sweep, &refs, &source)?);
         rows.extend(shaded_rows(backend, &b, sweep, &refs, env)?);
+    }
+    // The end-to-end measure: what a renderer shows.
+    let native = crate::plan::native_face_size(env);
+    let methods = sweep.methods(native);
+    let src = methods[0].settings.source_size;
+    let acc_source = bake::source_cube(&Backend::Cpu, env, &Settings { source_size: src, size: src, ..Settings::default() }.fitted())?;
+    eprintln!("report: end-to-end references (f64, {} shading points, {} lookups, {src}² source) …", sweep.accuracy_points.0, sweep.accuracy_points.1);
+    let points = crate::accuracy::Points::new(&acc_source, sweep.accuracy_points.0, sweep.accuracy_points.1);
+    for backend in backends {
+        rows.extend(crate::accuracy::measure(backend, env, &methods, &points)?);
     }
     write_outputs(dir, name, backends, sweep, &rows)?;
     Ok(rows)
@@ -418,7 +459,7 @@ fn shaded_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, env
                 .iter()
                 .filter(|p| in_view(p, lo, hi))
                 .map(|p| {
-                    let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, p.n, p.v, p.material.roughness);
+                    let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, ShadeOptions::DEFAULT.flags, p.n, p.v, p.material.roughness);
                     rel(shade::ibl(ShadeOptions::DEFAULT, &p.material, p.n, p.v, s), p.full)
                 })
                 .collect();

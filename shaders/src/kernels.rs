@@ -9,6 +9,7 @@
 //! terms per dispatch, carrying compensated partial sums in the output buffer; the host
 //! resolves them with the same functions the CPU backend uses.
 
+use crate::brdf::microfacet::Masking;
 use crate::cubemap::{self, CubeLayout};
 use crate::math::MeanPartial;
 use crate::{equirect, irradiance, lut, prefilter};
@@ -55,6 +56,35 @@ pub fn brdf_lut(
         let i = (y * p.size + id.x) as usize;
         let c = lut::texel_coords(id.x, y, p.size);
         accum[i] = lut::accumulate(c.x, c.y, p.samples, p.start, p.count, accum[i]);
+    }
+}
+
+/// Parameters of [`brdf_table`].
+#[derive(Copy, Clone, Debug, Pod, Zeroable)]
+#[repr(C)]
+pub struct TableParams {
+    /// Table width and height.
+    pub size: u32,
+    /// `microfacet::Masking` code.
+    pub masking: u32,
+    /// First row of this dispatch.
+    pub row_offset: u32,
+    /// Unused; keeps the block 16 bytes.
+    pub pad: u32,
+}
+
+/// One texel of the split-sum BRDF table by deterministic quadrature
+/// (`lut::integrate_brdf_quadrature`): `(A, B)` in `out[y·size + x].xy`.
+#[spirv(compute(threads(8, 8)))]
+pub fn brdf_table(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &TableParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+) {
+    let y = id.y + p.row_offset;
+    if id.x < p.size && y < p.size {
+        let t = lut::texel_quadrature(id.x, y, p.size, Masking::from_u32(p.masking));
+        out[(y * p.size + id.x) as usize] = Vec4::new(t.x, t.y, 0.0, 0.0);
     }
 }
 

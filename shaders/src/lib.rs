@@ -22,6 +22,7 @@ pub mod kernels;
 pub mod lut;
 pub mod math;
 pub mod prefilter;
+pub mod quadrature;
 pub mod sampling;
 pub mod scene;
 pub mod shade;

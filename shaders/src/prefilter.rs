@@ -30,12 +30,24 @@ pub enum RoughnessMapping {
     Linear = 0,
     /// `r = (m / (M − 1))²`: more mips at low roughness, where the lobe changes fastest.
     Quadratic = 1,
+    /// Mip 0 the mirror; from mip 1 on the GGX width doubles per mip, up to `α = 1` (r = 1)
+    /// at the last: `α_m = 2^(m − (M − 1))`. Face sizes halve per mip, so every mip holds
+    /// its lobe at the same number of texels, `α_m·s_m = s₀·2^(1−M)` (as Filament's and
+    /// Bevy's log-roughness mappings aim for). Between the mirror and mip 1, `α` is
+    /// interpolated linearly.
+    Geometric = 2,
 }
 
 impl RoughnessMapping {
     /// The mapping encoded as `u32` in kernel parameters; unknown codes are linear.
     pub fn from_u32(code: u32) -> Self {
-        if code == 1 { Self::Quadratic } else { Self::Linear }
+        if code == 1 {
+            Self::Quadratic
+        } else if code == 2 {
+            Self::Geometric
+        } else {
+            Self::Linear
+        }
     }
 
     /// Roughness of mip `mip` out of `mips`.
@@ -48,6 +60,14 @@ impl RoughnessMapping {
         match self {
             Self::Linear => t,
             Self::Quadratic => t * t,
+            Self::Geometric => {
+                if mip == 0 {
+                    0.0
+                } else {
+                    // r = √α = 2^((m − (M − 1))/2)
+                    math::exp2(0.5 * (mip as f32 - (mips - 1) as f32))
+                }
+            }
         }
     }
 
@@ -55,11 +75,19 @@ impl RoughnessMapping {
     #[inline]
     pub fn lod(self, roughness: f32, mips: u32) -> f32 {
         let r = math::saturate(roughness);
-        let t = match self {
-            Self::Linear => r,
-            Self::Quadratic => math::sqrt(r),
-        };
-        t * (mips as f32 - 1.0)
+        if mips <= 1 {
+            return 0.0;
+        }
+        let top = mips as f32 - 1.0;
+        match self {
+            Self::Linear => r * top,
+            Self::Quadratic => math::sqrt(r) * top,
+            Self::Geometric => {
+                let alpha = r * r;
+                let alpha1 = math::exp2(1.0 - top); // α of mip 1
+                if alpha >= alpha1 { top + math::log2(alpha) } else { alpha / alpha1 }
+            }
+        }
     }
 }
 

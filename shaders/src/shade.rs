@@ -95,6 +95,15 @@ impl ShadeOptions {
     pub const IBL: u32 = 1;
     /// Direct lights on.
     pub const DIRECT: u32 = 2;
+    /// Read the prefiltered cube along the specular dominant direction instead of the
+    /// mirror direction ([`dominant_direction`]).
+    pub const DOMINANT_DIRECTION: u32 = 4;
+    /// Multiple-scattering energy compensation of the image-based specular
+    /// ([`multiple_scattering`]).
+    pub const MULTISCATTER: u32 = 8;
+    /// Direct lights with the exact height-correlated Smith visibility instead of
+    /// Smith–Schlick (image-based light follows the table's own model).
+    pub const CORRELATED_SMITH: u32 = 16;
 
     /// Cook–Torrance, Lambert, Schlick, both lights.
     pub const DEFAULT: ShadeOptions = ShadeOptions {
@@ -167,7 +176,11 @@ pub fn direct(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, l: Vec3, radia
     let alpha = alpha_from_roughness(r);
     let specular = if opts.specular == specular_model::COOK_TORRANCE {
         let d = microfacet::d_ggx_vec(n, h, alpha);
-        let vis = microfacet::vis_smith_schlick(n_dot_v, n_dot_l, microfacet::k_direct(r));
+        let vis = if opts.flags & ShadeOptions::CORRELATED_SMITH != 0 {
+            microfacet::vis_smith_correlated(n_dot_v, n_dot_l, alpha)
+        } else {
+            microfacet::vis_smith_schlick(n_dot_v, n_dot_l, microfacet::k_direct(r))
+        };
         f * (d * vis)
     } else if opts.specular == specular_model::PHONG {
         let refl = sampling::reflect(v, n);
@@ -225,10 +238,33 @@ pub struct EnvironmentShape {
     pub pad: u32,
 }
 
-/// Reads the three baked products for normal `n`, view `v` and `roughness`.
-pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], n: Vec3, v: Vec3, roughness: f32) -> IblSample {
+/// The direction the prefiltered cube is read along for normal `n`, mirror direction
+/// `r` and perceptual `roughness`: `r` itself, or with [`ShadeOptions::DOMINANT_DIRECTION`]
+/// the specular dominant direction of Lagarde & de Rousiers 2014 ("Moving Frostbite to
+/// PBR", §4.9.3, listing 22): `lerp(n, r, s(√s + α))`, `s = 1 − α`. The lobe of `f_s·(n·l)`
+/// leans from the mirror direction towards the normal as roughness grows; `n = v = r`
+/// ignores that, and this fitted lerp restores most of it at the cost of one lerp and one
+/// normalisation per pixel.
+#[inline]
+pub fn specular_direction(flags: u32, n: Vec3, r: Vec3, roughness: f32) -> Vec3 {
+    if flags & ShadeOptions::DOMINANT_DIRECTION != 0 { dominant_direction(n, r, roughness) } else { r }
+}
+
+/// The specular dominant direction (see [`specular_direction`]).
+#[inline]
+pub fn dominant_direction(n: Vec3, r: Vec3, roughness: f32) -> Vec3 {
+    let alpha = alpha_from_roughness(math::saturate(roughness));
+    let smooth = 1.0 - alpha;
+    let t = smooth * (math::sqrt(smooth) + alpha);
+    sampling::normalize_or(n + (r - n) * t, r)
+}
+
+/// Reads the three baked products for normal `n`, view `v` and `roughness`; `flags` are
+/// [`ShadeOptions::flags`] (the read direction depends on them).
+#[allow(clippy::too_many_arguments)]
+pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], flags: u32, n: Vec3, v: Vec3, roughness: f32) -> IblSample {
     let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
-    let r = sampling::reflect(v, n);
+    let r = specular_direction(flags, n, sampling::reflect(v, n), roughness);
     let spec_layout = CubeLayout::new(shape.specular_size, shape.specular_levels);
     let lod = RoughnessMapping::from_u32(shape.mapping).lod(roughness, shape.specular_levels);
     IblSample {
@@ -251,6 +287,11 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
     } else {
         (Vec3::ONE - f) * no_metal * m.base_color * s.irradiance
     };
+    if opts.specular == specular_model::COOK_TORRANCE && opts.flags & ShadeOptions::MULTISCATTER != 0 && opts.diffuse != diffuse_model::FRESNEL_WEIGHTED {
+        let (single, multiple) = multiple_scattering(f, f0, s.brdf);
+        let kd = (Vec3::ONE - single - multiple) * no_metal;
+        return (kd * m.base_color * s.irradiance + single * s.prefiltered + multiple * s.irradiance) * m.occlusion;
+    }
     let specular = if opts.specular == specular_model::COOK_TORRANCE {
         s.prefiltered * (f * s.brdf.x + Vec3::splat(s.brdf.y))
     } else if opts.specular == specular_model::NONE {
@@ -259,4 +300,28 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
         s.prefiltered * f
     };
     (diffuse + specular) * m.occlusion
+}
+
+/// Single- and multiple-scattering weights of the image-based specular, `(F·A + B,
+/// F_ms·E_ms)`, from the split-sum table `(A, B)` at this `(n·v, r)` (Fdez-Agüera 2019,
+/// "A Multiple-Scattering Microfacet Model for Real-Time Image-based Lighting", JCGT 8(1),
+/// eqs. 10–16, after Kulla & Conty 2017):
+///
+/// - `E_ss = A + B` is the single-scattering albedo of the lobe with `F₀ = 1`: the energy
+///   channel of the table. A white GGX metal reflects only `E_ss` of the light; the rest,
+///   `E_ms = 1 − E_ss`, leaves after more than one bounce between microfacets.
+/// - `F_avg = F₀ + (1 − F₀)/21` is Schlick's Fresnel averaged over the hemisphere (cosine
+///   weighted), and each further bounce keeps `F_avg` of the light:
+///   `F_ms = (F·A + B)·F_avg / (1 − E_ms·F_avg)`.
+/// - The multiply scattered light is spread like a diffuse lobe, so it is lit by the
+///   irradiance: `L_o = (F·A + B)·L̃ + F_ms·E_ms·E/π`.
+///
+/// Under a white furnace (`L̃ = E/π = 1`) a metal with `F₀ = 1` then reflects exactly 1.
+#[inline]
+pub fn multiple_scattering(f: Vec3, f0: Vec3, brdf: Vec2) -> (Vec3, Vec3) {
+    let single = f * brdf.x + Vec3::splat(brdf.y);
+    let e_ms = math::saturate(1.0 - brdf.x - brdf.y);
+    let f_avg = f0 + (Vec3::ONE - f0) * (1.0 / 21.0);
+    let f_ms = single * f_avg / (Vec3::ONE - f_avg * e_ms);
+    (single, f_ms * e_ms)
 }

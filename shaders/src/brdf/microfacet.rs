@@ -73,3 +73,39 @@ pub fn vis_smith_schlick(n_dot_v: f32, n_dot_l: f32, k: f32) -> f32 {
     let denom = 4.0 * v * l;
     if denom > 0.0 { 1.0 / denom } else { 0.0 }
 }
+
+/// The masking–shadowing term a BRDF table or a light is evaluated with.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Masking {
+    /// Separable Smith with Schlick's `G₁` (`k = α/2` for image-based light, `(r+1)²/8`
+    /// for direct light): UE4's choice (Karis 2013).
+    SmithSchlick = 0,
+    /// The exact height-correlated Smith term of GGX (Heitz 2014, "Understanding the
+    /// Masking-Shadowing Function in Microfacet-Based BRDFs", JCGT 3(2), eq. 99).
+    SmithCorrelated = 1,
+}
+
+impl Masking {
+    /// The model encoded as `u32` in kernel parameters; unknown codes are Smith–Schlick.
+    pub fn from_u32(code: u32) -> Self {
+        if code == 1 { Self::SmithCorrelated } else { Self::SmithSchlick }
+    }
+}
+
+/// The height-correlated Smith visibility of GGX, `V = G₂ / (4 (n·l)(n·v))`, with
+/// `G₂ = 1 / (1 + Λ(v) + Λ(l))` and `Λ(x) = (√(1 + α² tan²θₓ) − 1)/2` (Heitz 2014, eq. 99),
+/// rewritten without tangents as
+/// `V = ½ / ((n·l)√((n·v)²(1−α²) + α²) + (n·v)√((n·l)²(1−α²) + α²))`
+/// (Filament, "Physically Based Rendering in Filament", §4.4.2): finite at grazing angles
+/// whenever `α > 0`.
+#[inline]
+pub fn vis_smith_correlated(n_dot_v: f32, n_dot_l: f32, alpha: f32) -> f32 {
+    let nv = math::saturate(n_dot_v);
+    let nl = math::saturate(n_dot_l);
+    let a2 = alpha * alpha;
+    let gv = nl * math::sqrt(nv * nv * (1.0 - a2) + a2);
+    let gl = nv * math::sqrt(nl * nl * (1.0 - a2) + a2);
+    let denom = gv + gl;
+    if denom > 0.0 { 0.5 / denom } else { 0.0 }
+}
