@@ -78,18 +78,22 @@ fn only_metals_drop_the_irradiance() {
 
 #[test]
 fn a_roughness_range_keeps_the_mips_around_it() {
-    // Six mips at roughness m/5 (the 128² cube this range asks for): r ∈ [0.4, 0.7] reads
-    // lod 2 … 3.5, so mips 2, 3 and 4 (trilinear filtering's upper neighbour).
+    // The geometric mapping on the 64² cube this range asks for: M = 4 mips, α of mip m ≥ 1
+    // is 2^(−4(3−m)/2), lod = 1 + 2(log₂α + 4)/4 above α₁ = 1/16. r = 0.4 (α = 0.16) reads
+    // lod 1.68 and r = 0.7 (α = 0.49) lod 2.49: mips 1, 2 and 3 (trilinear filtering's
+    // upper neighbour).
     let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
-    assert_eq!(p.settings.mips, 6);
-    assert_eq!(p.levels, vec![2, 3, 4]);
+    assert_eq!(p.settings.mips, 4);
+    assert_eq!(p.levels, vec![1, 2, 3]);
     assert!(skipped(&p, "specular mips"));
-    // A single roughness on a mip's own value needs only that mip.
+    // A single roughness: 0.6 (α = 0.36) on a 32² cube (M = 3) reads lod 1 + (log₂0.36 + 3)/3
+    // = 1.51: mips 1 and 2.
     let p = planned(&scene("", &material("satin", "roughness = 0.6")));
-    assert_eq!(p.levels, vec![3]);
-    // Two materials: the union of their mips.
+    assert_eq!((p.settings.size, p.levels.clone()), (32, vec![1, 2]));
+    // Two materials: the union of their mips. r = 0.2 needs the 256² cube (M = 6, lod 1.90);
+    // r = 0.85 and 0.9 read lod 4.69 and 4.80.
     let two = format!("{}{}", material("a", "roughness = 0.2"), material("b", "roughness = [0.85, 0.9]"));
-    assert_eq!(planned(&scene("", &two)).levels, vec![1, 4, 5]);
+    assert_eq!(planned(&scene("", &two)).levels, vec![1, 2, 4, 5]);
 }
 
 #[test]
@@ -116,14 +120,15 @@ fn no_image_light_bakes_nothing() {
 
 #[test]
 fn the_smallest_roughness_and_the_output_set_the_cube_size() {
-    // Roughness ≥ 0.4 reads mip 2 at the finest; half its lobe (α/2 = 0.08 rad) needs a
-    // texel of at most 0.08 rad there: π/2 / 32 = 0.049 (a 128² cube), not π/2 / 16 = 0.098.
+    // Roughness ≥ 0.4 (α = 0.16): half its lobe, 0.08 rad, needs a texel of at most 0.08 rad
+    // in the mip it reads. On a 32² cube (M = 3) it reads lod 1.12, mip 1 of 16² (texel
+    // π/2 / 16 = 0.098: too coarse); on a 64² cube (M = 4) lod 1.68, mip 1 of 32² (0.049).
     let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
-    assert_eq!(p.settings.size, 128);
-    // Rougher still: r ≥ 0.8 reads mip 4 (lod 5r), half its lobe is 0.32 rad: mip 4 of a
-    // 64² cube is 4² (texel 0.39 rad, too coarse), of a 128² cube 8² (0.196 rad).
+    assert_eq!(p.settings.size, 64);
+    // Rougher still: r ≥ 0.8, half its lobe 0.32 rad. An 8² cube (M = 2: the mirror and
+    // r = 1) reads mip 1 of 4² (0.39 rad, too coarse); a 16² cube mip 1 of 8² (0.196 rad).
     let p = planned(&scene("", &material("rough", "roughness = [0.8, 1.0]")));
-    assert_eq!(p.settings.size, 128);
+    assert_eq!(p.settings.size, 16);
     // A mirror needs a pixel's resolution, capped by the environment's own.
     let mirror = material("mirror", "metallic = 1.0\nroughness = 0.0");
     assert_eq!(planned(&scene("", &mirror)).settings.size, 256);
@@ -380,16 +385,17 @@ fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
     assert_eq!(plan_json["plan"]["products"]["irradiance"], false);
     assert!(out.join("specular.ktx2").exists() && out.join("brdf_lut.exr").exists());
     assert!(!out.join("irradiance.ktx2").exists(), "left-out products are not written");
-    // specular.ktx2 holds mips 2 … 4 of the 32² cube: an 8² cube with three mips.
+    // specular.ktx2 holds mips 1 … 2 of the 32² cube (M = 3: r = 0, √⅛, 1; r ∈ [0.4, 0.7]
+    // reads lod 1.12 … 1.66): a 16² cube with two mips.
     let ktx = std::fs::read(out.join("specular.ktx2")).unwrap();
     let reader = ktx2::Reader::new(&ktx[..]).expect("a KTX2 file");
     let h = reader.header();
-    assert_eq!((h.pixel_width, h.face_count, h.level_count), (8, 6, 3));
+    assert_eq!((h.pixel_width, h.face_count, h.level_count), (16, 6, 2));
     let r: Vec<f64> = plan_json["specular_roughness_per_mip"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
-    assert!(r.iter().zip([0.4, 0.6, 0.8]).all(|(a, b)| (a - b).abs() < 1e-6), "{r:?}");
+    assert!(r.len() == 2 && r.iter().zip([0.125f64.sqrt(), 1.0]).all(|(a, b)| (a - b).abs() < 1e-6), "{r:?}");
     // The scene sets the quality: a quality flag beside --scene is refused, not ignored.
     let mut with_flag = args.to_vec();
-    with_flag.extend(["--samples", "64"]);
+    with_flag.extend(["--samples", "128"]);
     let e = runner::cli::run(with_flag).expect_err("--samples with --scene");
     assert!(format!("{e:#}").contains("[quality]"), "{e:#}");
     let entries = std::fs::read_dir(&cache).unwrap().count();

@@ -146,6 +146,12 @@ fn radical3(mut i: u32) -> f32 {
     r as f32
 }
 
+/// The golden-ratio sequence `frac(i·φ)`: a low-discrepancy dimension uncorrelated with
+/// the parity of `i` (which picks metal or dielectric, sun or not).
+fn golden(i: u32) -> f32 {
+    ((i as f64 * 0.618_033_988_749_895 + 0.5).fract()) as f32
+}
+
 /// A unit vector perpendicular to `n`, turned by `turn` (in turns) about it.
 fn tangent(n: Vec3, turn: f32) -> Vec3 {
     let (t, b) = sampling::orthonormal_basis(n);
@@ -163,7 +169,7 @@ impl Points {
         let mut pts = Vec::new();
         for i in 0..shading {
             let nv = (1.0 - radical3(i + 1)).max(1e-3);
-            let r = 0.02 + 0.98 * sampling::radical_inverse(i.wrapping_mul(7) + 3);
+            let r = 0.02 + 0.98 * golden(i);
             let turn = sampling::hammersley(i, shading).x;
             // Every fourth point faces the sun; every fourth (offset by two) mirrors it.
             let (n, v) = match i % 4 {
@@ -210,7 +216,7 @@ impl Points {
         // Lookups: half within a few lobe widths of the sun, half anywhere.
         let look: Vec<(Vec3, f32, bool)> = (0..lookups)
             .map(|i| {
-                let r = 0.02 + 0.98 * sampling::radical_inverse(i.wrapping_mul(5) + 1);
+                let r = 0.02 + 0.98 * golden(i / 2);
                 let near = i % 2 == 0;
                 let dir = if near {
                     // Up to three lobe widths (α = r², at least two source texels) from the sun.
@@ -223,7 +229,10 @@ impl Points {
                 (dir, r, near)
             })
             .collect();
-        let lookups = look.into_par_iter().map(|(dir, roughness, near_sun)| LookupPoint { dir, roughness, near_sun, exact: env.prefilter(arr(dir), roughness as f64) }).collect();
+        let lookups = look
+            .into_par_iter()
+            .map(|(dir, roughness, near_sun)| LookupPoint { dir, roughness, near_sun, exact: env.prefilter(arr(dir), roughness as f64) })
+            .collect();
         Self { shading, lookups, source_size: s }
     }
 }
@@ -238,6 +247,7 @@ pub fn seed_settings(source_size: u32) -> Settings {
         mips: 6.min(splitsum_shaders::cubemap::CubeLayout::full_chain(source_size)),
         mapping: bake::Mapping::Linear,
         samples: 1024,
+        sample_growth: 1,
         lod_bias: 0.5,
         lut_method: bake::TableMethod::Sampled,
         lut_samples: 1024,

@@ -10,10 +10,10 @@ use crate::cpu;
 use crate::error::{Error, Result};
 use crate::gpu::{self, Dispatch, Gpu, Kernel};
 use crate::texture::{Cube, Equirect, Lut, Sh9};
+use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
-use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::kernels::{self, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, TableParams, probe_mode};
 use splitsum_shaders::math::{CHUNK, MeanPartial};
 use splitsum_shaders::{equirect, lut, prefilter};
@@ -217,13 +217,13 @@ impl Backend {
     /// `roughness[m]` with `samples` GGX samples and source-level bias `lod_bias`.
     pub fn prefilter(&self, src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Result<Cube> {
         let all: Vec<u32> = (0..out.levels).collect();
-        self.prefilter_levels(src, out, roughness, &all, samples, lod_bias)
+        self.prefilter_levels(src, out, roughness, &all, &vec![samples; out.levels as usize], lod_bias)
     }
 
     /// As [`Backend::prefilter`], baking only `levels` (the other levels stay zero: a plan
-    /// leaves out what nothing reads).
-    pub fn prefilter_levels(&self, src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32], samples: u32, lod_bias: f32) -> Result<Cube> {
-        if samples == 0 {
+    /// leaves out what nothing reads), level `m` from `samples[m]` GGX samples.
+    pub fn prefilter_levels(&self, src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32], samples: &[u32], lod_bias: f32) -> Result<Cube> {
+        if samples.contains(&0) {
             return Err(Error::Invalid("--samples must be at least 1".into()));
         }
         let g = match self {
@@ -233,7 +233,7 @@ impl Backend {
         let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
         let accum = g.output("specular sums", out.texel_count() as u64 * 48)?;
         for &m in levels {
-            let r = roughness[m as usize];
+            let (r, samples) = (roughness[m as usize], samples[m as usize]);
             if r <= 0.0 {
                 continue; // a mirror: resolved from the source below
             }
@@ -276,7 +276,7 @@ impl Backend {
                 for y in 0..s {
                     for x in 0..s {
                         texels.push(if r <= 0.0 {
-                            prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples, lod_bias)
+                            prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples[m as usize], lod_bias)
                         } else {
                             partial(&sums, out.index(m, face, x, y) as usize).resolve()
                         });

@@ -28,7 +28,8 @@ pub enum Mapping {
     Linear,
     /// `r = (m/(M−1))²`.
     Quadratic,
-    /// Mip 0 the mirror, then `α` doubling per mip up to `r = 1` at the last.
+    /// Mip 0 the mirror, mip 1 at `α = 2^(−M)`, then `α` in geometric progression up to
+    /// `r = 1` at the last.
     Geometric,
 }
 
@@ -85,8 +86,12 @@ pub struct Settings {
     pub mips: u32,
     /// Roughness of each mip.
     pub mapping: Mapping,
-    /// GGX samples per specular texel.
+    /// GGX samples per texel of specular mip 1 (the sharpest filtered mip).
     pub samples: u32,
+    /// Factor by which the sample count grows per mip after mip 1 (1: the same count on
+    /// every mip, the seed method). Mips shrink by 4 in texels, so a factor up to 4 keeps
+    /// each mip's cost at most mip 1's, and rough lobes need the samples.
+    pub sample_growth: u32,
     /// Added to the source level each prefilter sample reads (`½·log₂(Ωs/Ωp) + bias`).
     pub lod_bias: f32,
     /// Supersampling density of the equirect → cube resampling (points per source texel
@@ -116,12 +121,13 @@ impl Default for Settings {
             size: 256,
             source_size: 256,
             mips: 6,
-            mapping: Mapping::Linear,
-            samples: 1024,
+            mapping: Mapping::Geometric,
+            samples: 64,
+            sample_growth: 2,
             lod_bias: 0.5,
             supersample_density: 2.0,
             irradiance_size: 32,
-            irradiance_source: 32,
+            irradiance_source: 16,
             sh_source: 32,
             lut_size: 256,
             lut_samples: 1024,
@@ -156,6 +162,9 @@ impl Settings {
         if self.samples == 0 {
             return Err(Error::Invalid("--samples must be at least 1".into()));
         }
+        if !(1..=4).contains(&self.sample_growth) {
+            return Err(Error::Invalid(format!("--sample-growth must be from 1 to 4, not {}", self.sample_growth)));
+        }
         if !(self.lod_bias.is_finite() && (-16.0..=16.0).contains(&self.lod_bias)) {
             return Err(Error::Invalid(format!("--lod-bias must be within ±16, not {}", self.lod_bias)));
         }
@@ -171,6 +180,15 @@ impl Settings {
         Ok(())
     }
 
+    /// The specular mip count for mip-0 faces of `size`: down to 8² faces, and at least two
+    /// (the mirror and roughness 1) where the chain has them. With the geometric mapping
+    /// this puts mip 1's GGX width at `α₁ = 2^(−M) = 4/size`: two of mip 1's texels. The one
+    /// rule for the bake, the display and the planner.
+    pub fn default_mips(size: u32) -> u32 {
+        let chain = CubeLayout::full_chain(size.max(1));
+        chain.saturating_sub(3).max(2).min(chain)
+    }
+
     /// These settings with the mip count held within the specular cube's chain (for small
     /// `size`s, as the report's quick sweep uses).
     pub fn fitted(self) -> Self {
@@ -182,6 +200,12 @@ impl Settings {
     pub fn roughness(&self) -> Vec<f32> {
         let m: RoughnessMapping = self.mapping.into();
         (0..self.mips).map(|i| m.roughness(i, self.mips)).collect()
+    }
+
+    /// GGX samples of each specular mip: `samples × sample_growth^(m−1)` from mip 1 on
+    /// (mip 0 is the mirror unless the mapping says otherwise), at most 2²⁰.
+    pub fn samples_per_mip(&self) -> Vec<u32> {
+        (0..self.mips).map(|m| (self.samples as u64 * (self.sample_growth as u64).pow(m.saturating_sub(1))).min(1 << 20) as u32).collect()
     }
 
     /// Layout of the specular cube.
@@ -285,7 +309,8 @@ pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products:
     let source = timed(&mut timings, "source cube", || source_cube(backend, env, settings))?;
     let specular = if products.specular {
         Some(timed(&mut timings, "specular", || {
-            backend.prefilter(&source, settings.specular_layout(), &settings.roughness(), settings.samples, settings.lod_bias)
+            let all: Vec<u32> = (0..settings.mips).collect();
+            backend.prefilter_levels(&source, settings.specular_layout(), &settings.roughness(), &all, &settings.samples_per_mip(), settings.lod_bias)
         })?)
     } else {
         None
@@ -540,7 +565,9 @@ pub fn bake_plan(backend: &Backend, env: &Environment, plan: &crate::plan::Plan)
     let mut timings = Vec::new();
     let source = timed(&mut timings, "source cube", || source_cube(backend, env, s))?;
     let specular = if plan.products.specular {
-        timed(&mut timings, "specular", || backend.prefilter_levels(&source, s.specular_layout(), &s.roughness(), &plan.levels, s.samples, s.lod_bias))?
+        timed(&mut timings, "specular", || {
+            backend.prefilter_levels(&source, s.specular_layout(), &s.roughness(), &plan.levels, &s.samples_per_mip(), s.lod_bias)
+        })?
     } else {
         empty_cube()
     };
@@ -550,11 +577,7 @@ pub fn bake_plan(backend: &Backend, env: &Environment, plan: &crate::plan::Plan)
     } else {
         empty_cube()
     };
-    let lut = if plan.products.lut {
-        timed(&mut timings, "brdf lut", || brdf_table(backend, s))?
-    } else {
-        Lut { size: 1, texels: vec![Default::default()] }
-    };
+    let lut = if plan.products.lut { timed(&mut timings, "brdf lut", || brdf_table(backend, s))? } else { Lut { size: 1, texels: vec![Default::default()] } };
     let source = Cube { layout: CubeLayout::new(source.layout.size, 1), texels: source.level(0).to_vec() };
     Ok((crate::render::BakedEnvironment { source, specular, irradiance, lut, mapping: s.mapping.into() }, timings))
 }

@@ -152,17 +152,15 @@ pub struct Plan {
     pub cost: Cost,
     /// A full bake's cost at the same settings (every product, every mip).
     pub full_cost: Cost,
-    /// The cost of `runner bake ENV` at its defaults (every product at 256², 1024
-    /// samples): what baking without a plan costs.
+    /// The cost of `runner bake ENV` at its defaults (every product at 256²): what baking
+    /// without a plan costs.
     pub default_cost: Cost,
 }
 
-/// Mips of a specular cube of face size `size`: down to 4×4 as at the default 256² (six
-/// mips), and never fewer than six (down to 1×1 if need be), so that the roughness steps
-/// between mips stay as fine as the default's.
+/// Mips of a specular cube of face size `size`: the bake's own rule
+/// ([`Settings::default_mips`]).
 pub fn mip_count(size: u32) -> u32 {
-    let chain = CubeLayout::full_chain(size);
-    chain.saturating_sub(3).max(6).min(chain)
+    Settings::default_mips(size)
 }
 
 /// Plans the bake of `scene` over the loaded environment `env`.
@@ -208,7 +206,9 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
         size >> (mapping.lod(r_min, mips).floor() as u32).min(mips - 1)
     };
     let mut wanted = 8u32;
-    while wanted < 4096 && std::f64::consts::FRAC_PI_2 / (finest_read(wanted) as f64) > texel {
+    // A blurred sky reads mip `sky_blur` (fractional): the cube needs the mips above it.
+    let blur_mips = if scene.sky_blur > 0.0 { scene.sky_blur.ceil() as u32 + 1 } else { 0 };
+    while wanted < 4096 && (std::f64::consts::FRAC_PI_2 / (finest_read(wanted) as f64) > texel || mip_count(wanted) < blur_mips) {
         wanted *= 2;
     }
     let size = scene.quality.size.unwrap_or(wanted.min(native));
@@ -367,10 +367,11 @@ pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, ca
     if products.specular {
         let out = s.specular_layout();
         let mapping: RoughnessMapping = s.mapping.into();
+        let samples = s.samples_per_mip();
         for &l in levels {
             let texels = 6.0 * (out.level_size(l) as f64).powi(2);
             if mapping.roughness(l, s.mips) > 0.0 {
-                work[1] += texels * s.samples as f64;
+                work[1] += texels * samples[l as usize] as f64;
             }
             bytes += texels as u64 * 16;
         }

@@ -111,11 +111,7 @@ impl Sweep {
             Method { label: "defaults".into(), settings: default.clone(), flags },
             Method { label: "defaults, mirror direction".into(), settings: default.clone(), flags: flags & !ShadeOptions::DOMINANT_DIRECTION },
             Method { label: "defaults + multiple scattering".into(), settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
-            Method {
-                label: "defaults, exact-Smith table".into(),
-                settings: Settings { lut_masking: crate::bake::MaskingModel::Correlated, ..default },
-                flags,
-            },
+            Method { label: "defaults, exact-Smith table".into(), settings: Settings { lut_masking: crate::bake::MaskingModel::Correlated, ..default }, flags },
         ]
     }
 

@@ -30,11 +30,12 @@ pub enum RoughnessMapping {
     Linear = 0,
     /// `r = (m / (M − 1))²`: more mips at low roughness, where the lobe changes fastest.
     Quadratic = 1,
-    /// Mip 0 the mirror; from mip 1 on the GGX width doubles per mip, up to `α = 1` (r = 1)
-    /// at the last: `α_m = 2^(m − (M − 1))`. Face sizes halve per mip, so every mip holds
-    /// its lobe at the same number of texels, `α_m·s_m = s₀·2^(1−M)` (as Filament's and
-    /// Bevy's log-roughness mappings aim for). Between the mirror and mip 1, `α` is
-    /// interpolated linearly.
+    /// Mip 0 the mirror; mip 1 at `α₁ = 2^(−M)`, then `α` in geometric progression up to
+    /// `α = 1` (r = 1) at the last mip: `α_m = α₁^((M−1−m)/(M−2))`. With `M = log₂ s₀ − 2`
+    /// (mips down to 8²; the default), `α₁ = 4/s₀`: mip 1 holds its lobe at two of its
+    /// texels, and the lobe grows faster than the texels shrink from there on, so every
+    /// mip resolves its lobe (Filament's and Bevy's log-roughness mappings aim for the
+    /// same). Between the mirror and mip 1, `α` is interpolated linearly; above, `log α`.
     Geometric = 2,
 }
 
@@ -63,9 +64,12 @@ impl RoughnessMapping {
             Self::Geometric => {
                 if mip == 0 {
                     0.0
+                } else if mips <= 2 {
+                    1.0
                 } else {
-                    // r = √α = 2^((m − (M − 1))/2)
-                    math::exp2(0.5 * (mip as f32 - (mips - 1) as f32))
+                    // r = √α = 2^(−M(M−1−m) / (2(M−2)))
+                    let m = mips as f32;
+                    math::exp2(-m * (m - 1.0 - mip as f32) / (2.0 * (m - 2.0)))
                 }
             }
         }
@@ -84,8 +88,9 @@ impl RoughnessMapping {
             Self::Quadratic => math::sqrt(r) * top,
             Self::Geometric => {
                 let alpha = r * r;
-                let alpha1 = math::exp2(1.0 - top); // α of mip 1
-                if alpha >= alpha1 { top + math::log2(alpha) } else { alpha / alpha1 }
+                let m = mips as f32;
+                let alpha1 = math::exp2(-m); // α of mip 1
+                if alpha <= alpha1 { alpha / alpha1 } else { 1.0 + (m - 2.0) * (math::log2(alpha) + m) / m }
             }
         }
     }
