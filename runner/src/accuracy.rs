@@ -32,7 +32,6 @@ use crate::report::{Measurement, REL};
 use crate::texture::Cube;
 use rayon::prelude::*;
 use splitsum_reference as reference;
-use splitsum_shaders::cubemap;
 use splitsum_shaders::glam::{Vec2, Vec3};
 use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::shade::{self, EnvironmentShape, IblSample, Material, ShadeOptions};
@@ -315,12 +314,11 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             rows.push(Measurement::of(format!("shaded colour {key}: (c) model"), &b, label.clone(), f64::NAN, &col(|p| p.5), REL));
         }
         // The prefiltered radiance a renderer reads at any roughness.
-        let layout = spec.layout;
         let lookups: Vec<(f32, bool, f64)> = points
             .lookups
             .iter()
             .map(|q| {
-                let got = cubemap::sample_lod(&spec.texels, layout, q.dir, mapping.lod(q.roughness, layout.levels)).truncate();
+                let got = shade::prefiltered(shape, &spec.texels, opts.flags, q.dir, q.roughness).truncate();
                 (q.roughness, q.near_sun, rel(got, q.exact))
             })
             .collect();
