@@ -175,19 +175,15 @@ pub struct LookArgs {
     /// Hide the sphere grid.
     #[arg(long)]
     pub no_grid: bool,
+    #[command(flatten)]
+    pub shading: crate::scene::ShadingChoices,
 }
 
 impl LookArgs {
     /// The view these flags describe, with `auto_exposure` from the environment.
     pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
         use splitsum_shaders::shade::ShadeOptions;
-        let mut flags = 0;
-        if !self.no_ibl {
-            flags |= ShadeOptions::IBL;
-        }
-        if !self.no_lights {
-            flags |= ShadeOptions::DIRECT;
-        }
+        let flags = self.shading.flags(!self.no_ibl, !self.no_lights);
         let mut view = crate::render::ViewState {
             spheres: !self.no_grid,
             show_model: !self.no_model,
@@ -676,6 +672,7 @@ fn default_run() -> anyhow::Result<()> {
         model: None,
         no_model: true,
         no_grid: false,
+        shading: Default::default(),
     };
     let state = look.view(baked.auto_exposure());
     let backend = match backend {

@@ -197,6 +197,59 @@ pub struct MaterialSpec {
     /// Lit by the environment (image-based light).
     #[serde(default = "yes")]
     pub ibl: bool,
+    /// Read the prefiltered cube along the mirror direction (see [`ShadingChoices`]).
+    #[serde(default)]
+    pub mirror_direction: bool,
+    /// Multiple-scattering energy compensation.
+    #[serde(default)]
+    pub multiscatter: bool,
+    /// Filtered importance sampling below mip 1's roughness.
+    #[serde(default)]
+    pub filtered: bool,
+    /// The exact height-correlated Smith term for direct lights.
+    #[serde(default)]
+    pub exact_smith: bool,
+}
+
+/// The shading options a user chooses beside the models, with their defaults: the
+/// prefiltered cube read along the dominant direction, single scattering, no filtered
+/// sampling, Smith–Schlick for direct lights. The one place their flags are made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::Args)]
+#[serde(default)]
+pub struct ShadingChoices {
+    /// Read the prefiltered cube along the mirror direction (the seed's choice) instead of
+    /// the specular dominant direction.
+    #[arg(long)]
+    pub mirror_direction: bool,
+    /// Multiple-scattering energy compensation of the image-based specular (Fdez-Agüera 2019).
+    #[arg(long)]
+    pub multiscatter: bool,
+    /// Quality mode: filtered importance sampling at shading time below mip 1's roughness.
+    #[arg(long)]
+    pub filtered: bool,
+    /// The exact height-correlated Smith term for direct lights (the image-based light
+    /// follows the table's own model, `--lut-masking`).
+    #[arg(long)]
+    pub exact_smith: bool,
+}
+
+impl ShadingChoices {
+    /// `ShadeOptions` flags for these choices, with image-based and direct light as given.
+    pub fn flags(&self, ibl: bool, direct: bool) -> u32 {
+        let mut f = 0;
+        let mut set = |on: bool, bit: u32| {
+            if on {
+                f |= bit;
+            }
+        };
+        set(ibl, ShadeOptions::IBL);
+        set(direct, ShadeOptions::DIRECT);
+        set(!self.mirror_direction, ShadeOptions::DOMINANT_DIRECTION);
+        set(self.multiscatter, ShadeOptions::MULTISCATTER);
+        set(self.filtered, ShadeOptions::FILTERED_SAMPLING);
+        set(self.exact_smith, ShadeOptions::CORRELATED_SMITH);
+        f
+    }
 }
 
 fn default_base() -> [f32; 3] {
@@ -219,7 +272,13 @@ impl MaterialSpec {
             diffuse: self.diffuse.code(),
             specular: self.specular.code(),
             fresnel: self.fresnel.code(),
-            flags: ShadeOptions::DIRECT | if self.ibl { ShadeOptions::IBL } else { 0 },
+            flags: ShadingChoices {
+                mirror_direction: self.mirror_direction,
+                multiscatter: self.multiscatter,
+                filtered: self.filtered,
+                exact_smith: self.exact_smith,
+            }
+            .flags(self.ibl, true),
         }
     }
 }
