@@ -62,6 +62,9 @@ fn view_band(nv: f32) -> String {
 pub struct Method {
     /// Its name in the report.
     pub label: String,
+    /// The curve it belongs to on the error-against-time plot (methods that differ only in
+    /// a knob such as the sample count share one).
+    pub family: &'static str,
     /// How it bakes.
     pub settings: Settings,
     /// `ShadeOptions::flags` of its image-based light (`IBL` and options).
@@ -249,6 +252,7 @@ pub fn seed_settings(source_size: u32) -> Settings {
         sample_growth: 1,
         lod_bias: 0.5,
         lut_method: bake::TableMethod::Sampled,
+        lut_masking: MaskingModel::Schlick,
         lut_samples: 1024,
         ..Settings::default()
     }
@@ -295,7 +299,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             .collect();
         let label = &method.label;
         let all: Vec<f64> = per_point.iter().map(|p| p.2).collect();
-        rows.push(Measurement::of("shaded colour, end to end", &b, label.clone(), ms, &all, REL));
+        rows.push(Measurement::of(format!("shaded colour, end to end: {}", method.family), &b, label.clone(), ms, &all, REL));
         let mut bands: Vec<(String, Vec<&(f32, f32, f64, f64, f64, f64)>)> = Vec::new();
         for p in &per_point {
             for key in [roughness_band(p.0), view_band(p.1)] {
@@ -323,7 +327,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             })
             .collect();
         let all: Vec<f64> = lookups.iter().map(|l| l.2).collect();
-        rows.push(Measurement::of("prefiltered lookup, any roughness", &b, label.clone(), ms, &all, REL));
+        rows.push(Measurement::of(format!("prefiltered lookup, any roughness: {}", method.family), &b, label.clone(), ms, &all, REL));
         for &lo in &ROUGHNESS_BANDS {
             let band = roughness_band(lo);
             for (near, place) in [(true, "near the sun"), (false, "anywhere")] {

@@ -311,8 +311,9 @@ pub struct QualityArgs {
     #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
     pub lut_method: TableMethod,
     /// The table's masking–shadowing term.
-    #[arg(long, value_enum, default_value_t = MaskingModel::Schlick)]
-    pub lut_masking: MaskingModel,
+    /// [default: correlated; schlick with --lut-method sampled]
+    #[arg(long, value_enum)]
+    pub lut_masking: Option<MaskingModel>,
     /// KTX2 texel format; auto = RGBA16F unless a value exceeds 65504, then RGBA32F.
     #[arg(long, value_enum, default_value_t = Format::Auto)]
     pub format: Format,
@@ -337,7 +338,10 @@ impl QualityArgs {
             lut_size: self.lut_size,
             lut_samples: self.lut_samples,
             lut_method: self.lut_method,
-            lut_masking: self.lut_masking,
+            lut_masking: self.lut_masking.unwrap_or(match self.lut_method {
+                TableMethod::Quadrature => MaskingModel::Correlated,
+                TableMethod::Sampled => MaskingModel::Schlick,
+            }),
             format: self.format,
         }
     }
@@ -387,9 +391,10 @@ struct LutArgs {
     /// Deterministic quadrature (within 1e-5 of the f64 reference) or Hammersley sampling.
     #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
     method: TableMethod,
-    /// Masking–shadowing term: Smith–Schlick (k = α/2) or the exact height-correlated Smith.
-    #[arg(long, value_enum, default_value_t = MaskingModel::Schlick)]
-    masking: MaskingModel,
+    /// Masking–shadowing term: the exact height-correlated Smith or Smith–Schlick (k = α/2)
+    /// [default: correlated; schlick with --method sampled].
+    #[arg(long, value_enum)]
+    masking: Option<MaskingModel>,
     /// Hammersley points per texel (with --method sampled).
     #[arg(long, default_value_t = 1024)]
     samples: u32,
@@ -431,7 +436,11 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     }
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();
-    let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: args.masking, ..Settings::default() };
+    let masking = args.masking.unwrap_or(match args.method {
+        TableMethod::Quadrature => MaskingModel::Correlated,
+        TableMethod::Sampled => MaskingModel::Schlick,
+    });
+    let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: masking, ..Settings::default() };
     if args.samples == 0 {
         anyhow::bail!("--samples must be at least 1");
     }
@@ -442,7 +451,7 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
     let how = match args.method {
-        TableMethod::Quadrature => format!("by quadrature ({:?} masking)", args.masking),
+        TableMethod::Quadrature => format!("by quadrature ({masking:?} masking)"),
         TableMethod::Sampled => format!("at {} samples/texel", args.samples),
     };
     println!("brdf lut {}x{} {how} on {}: bake {:.3} s", args.size, args.size, backend.describe(), secs);
@@ -490,6 +499,8 @@ fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
         backend: backend.describe(),
         settings: settings.clone(),
         roughness_per_mip: settings.roughness(),
+        samples_per_mip: settings.samples_per_mip(),
+        accuracy: bake::DEFAULTS_ACCURACY,
         input: (&input).into(),
         timings: Vec::new(),
         sh9_vs_convolution: None,

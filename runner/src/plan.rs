@@ -78,7 +78,10 @@ impl Calibration {
             let err: f64 = f[4].parse().ok()?;
             let first_number = |s: &str| s.split(|ch: char| !ch.is_ascii_digit()).find(|t| !t.is_empty()).and_then(|t| t.parse::<u32>().ok());
             if f[0] == "brdf lut" {
-                c.lut.push((first_number(&f[2])?, err));
+                // The sampled table's rows (the quadrature's row has no sample count).
+                if let Some(n) = first_number(&f[2]) {
+                    c.lut.push((n, err));
+                }
             } else if f[0] == "irradiance (convolution)" {
                 c.irradiance.push((first_number(&f[2])?, err));
             } else if let Some(r) = f[0].strip_prefix("prefilter r=").and_then(|r| r.parse::<f32>().ok()) {
@@ -318,6 +321,7 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     if let Some(n) = q.lut_samples {
         settings.lut_samples = n;
         settings.lut_method = crate::bake::TableMethod::Sampled;
+        settings.lut_masking = crate::bake::MaskingModel::Schlick;
     } else if let (Some(e), true) = (target, lut) {
         decide("BRDF table method", true, format!("quadrature: max error 1e-5 at every texel ≤ {e}"));
     }

@@ -106,13 +106,39 @@ impl Sweep {
         let src = native.min(self.accuracy_source).max(4);
         let default = Settings { size: src, source_size: src, ..Settings::default() }.fitted();
         let flags = ShadeOptions::DEFAULT.flags & !(ShadeOptions::IBL | ShadeOptions::DIRECT);
-        vec![
-            Method { label: "seed (6 linear mips, 1024 samples, sampled table)".into(), settings: seed_settings(src), flags: 0 },
-            Method { label: "defaults".into(), settings: default.clone(), flags },
-            Method { label: "defaults, mirror direction".into(), settings: default.clone(), flags: flags & !ShadeOptions::DOMINANT_DIRECTION },
-            Method { label: "defaults + multiple scattering".into(), settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
-            Method { label: "defaults, exact-Smith table".into(), settings: Settings { lut_masking: crate::bake::MaskingModel::Correlated, ..default }, flags },
-        ]
+        let mut methods = Vec::new();
+        // Each method's error against its bake time: the seed at three sample counts, the
+        // defaults at three (mip 1's count; ×2 per mip after it).
+        for n in [64, 256, 1024] {
+            let label = if n == 1024 { "seed (6 linear mips, 1024 samples, sampled table)".to_string() } else { format!("seed, {n} samples") };
+            methods.push(Method { label, family: "seed method", settings: Settings { samples: n, ..seed_settings(src) }, flags: 0 });
+        }
+        for n in [16, 256] {
+            methods.push(Method { label: format!("defaults, {n} samples"), family: "defaults", settings: Settings { samples: n, ..default.clone() }, flags });
+        }
+        methods.extend(vec![
+            Method { label: "defaults".into(), family: "defaults", settings: default.clone(), flags },
+            Method {
+                label: "defaults, mirror direction".into(),
+                family: "options",
+                settings: default.clone(),
+                flags: flags & !ShadeOptions::DOMINANT_DIRECTION,
+            },
+            Method { label: "defaults + multiple scattering".into(), family: "options", settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
+            Method {
+                label: "defaults + filtered sampling".into(),
+                family: "options",
+                settings: default.clone(),
+                flags: flags | ShadeOptions::FILTERED_SAMPLING,
+            },
+            Method {
+                label: "defaults, Smith-Schlick table".into(),
+                family: "options",
+                settings: Settings { lut_masking: crate::bake::MaskingModel::Schlick, ..default },
+                flags,
+            },
+        ]);
+        methods
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -245,6 +271,7 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
         eprintln!("report: {b} …");
         // Warm-up, outside the timings: first dispatches pay for driver set-up and caches.
         backend.brdf_lut(4, 4)?;
+        backend.brdf_table(4, splitsum_shaders::brdf::microfacet::Masking::SmithSchlick)?;
         backend.prefilter(&source, CubeLayout::new(4, 1), &[0.5], 4, 0.0)?;
         backend.irradiance(&source, source.layout.levels - 1, 4)?;
         rows.extend(lut_rows(backend, &b, sweep, &refs)?);
@@ -367,6 +394,10 @@ fn lut_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References) -> Res
         let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
         rows.push(Measurement::of("brdf lut", b, format!("{n} samples"), ms, &errors, ABS));
     }
+    // The deterministic quadrature (the default table), on the same texels.
+    let (table, ms) = timed(|| backend.brdf_table(sweep.lut_size, splitsum_shaders::brdf::microfacet::Masking::SmithSchlick))?;
+    let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
+    rows.push(Measurement::of("brdf lut", b, "quadrature", ms, &errors, ABS));
     let n = *sweep.samples.last().expect("samples");
     for &size in &sweep.lut_sizes {
         let (table, ms) = timed(|| backend.brdf_lut(size, n))?;

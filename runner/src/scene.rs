@@ -206,14 +206,14 @@ pub struct MaterialSpec {
     /// Filtered importance sampling below mip 1's roughness.
     #[serde(default)]
     pub filtered: bool,
-    /// The exact height-correlated Smith term for direct lights.
+    /// Smith–Schlick instead of the exact Smith term for direct lights.
     #[serde(default)]
-    pub exact_smith: bool,
+    pub smith_schlick: bool,
 }
 
 /// The shading options a user chooses beside the models, with their defaults: the
 /// prefiltered cube read along the dominant direction, single scattering, no filtered
-/// sampling, Smith–Schlick for direct lights. The one place their flags are made.
+/// sampling, the exact Smith term for direct lights. The one place their flags are made.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::Args)]
 #[serde(default)]
 pub struct ShadingChoices {
@@ -227,10 +227,11 @@ pub struct ShadingChoices {
     /// Quality mode: filtered importance sampling at shading time below mip 1's roughness.
     #[arg(long)]
     pub filtered: bool,
-    /// The exact height-correlated Smith term for direct lights (the image-based light
-    /// follows the table's own model, `--lut-masking`).
+    /// Smith–Schlick (UE4's `k = (r+1)²/8`) for direct lights instead of the exact
+    /// height-correlated Smith term (the image-based light follows the table's own model,
+    /// `--lut-masking`).
     #[arg(long)]
-    pub exact_smith: bool,
+    pub smith_schlick: bool,
 }
 
 impl ShadingChoices {
@@ -247,7 +248,7 @@ impl ShadingChoices {
         set(!self.mirror_direction, ShadeOptions::DOMINANT_DIRECTION);
         set(self.multiscatter, ShadeOptions::MULTISCATTER);
         set(self.filtered, ShadeOptions::FILTERED_SAMPLING);
-        set(self.exact_smith, ShadeOptions::CORRELATED_SMITH);
+        set(!self.smith_schlick, ShadeOptions::CORRELATED_SMITH);
         f
     }
 }
@@ -276,7 +277,7 @@ impl MaterialSpec {
                 mirror_direction: self.mirror_direction,
                 multiscatter: self.multiscatter,
                 filtered: self.filtered,
-                exact_smith: self.exact_smith,
+                smith_schlick: self.smith_schlick,
             }
             .flags(self.ibl, true),
         }
