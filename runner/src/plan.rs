@@ -15,7 +15,9 @@
 //!   the environment itself;
 //! - SH9 is left out: the display reads the irradiance cube;
 //! - with `[quality] max_error`, each product gets the cheapest measured setting whose mean
-//!   error meets it ([`Calibration`], from `runner report`).
+//!   error meets it ([`Calibration`], from `runner report`); for the prefilter that error is
+//!   the end-to-end measure's: the share of the shaded colour's error the bake adds, in the
+//!   roughness bands the scene reads (`accuracy`, part (a)).
 
 use crate::bake::{Products, Settings};
 use crate::scene::{MaterialSpec, Scene, SpecularArg};
@@ -33,7 +35,9 @@ pub struct Calibration {
     pub source: String,
     /// BRDF table: (samples, mean absolute error).
     pub lut: Vec<(u32, f64)>,
-    /// Prefilter at bias 0.5: (roughness, [(samples, mean relative error)]).
+    /// The specular bake, end to end: (roughness at the middle of a band, [(samples at mip
+    /// 1, mean relative error the bake adds to the shaded colour)]), from the report's
+    /// `shaded colour r in [a, b): (a) bake` rows of the defaults at several sample counts.
     pub prefilter: Vec<(f32, Vec<(u32, f64)>)>,
     /// Irradiance convolution: (source face size, mean relative error).
     pub irradiance: Vec<(u32, f64)>,
@@ -47,15 +51,36 @@ impl Default for Calibration {
         Self {
             source: "built in: runner report on city.exr and courtyard.exr (the worse of the two), runner bench, lavapipe and 2 CPU cores".into(),
             lut: vec![(16, 1.98e-2), (64, 6.62e-3), (256, 2.56e-3), (1024, 8.86e-4), (4096, 2.93e-4)],
+            // Bands [0.02, 0.05) … [0.75, 1] of `runner report` on city.exr and courtyard.exr
+            // (the worse of the two), CPU backend.
             prefilter: vec![
-                (1.0 / 3.0, vec![(16, 0.445), (64, 0.209), (256, 0.069), (1024, 0.0196), (4096, 0.0087)]),
-                (2.0 / 3.0, vec![(16, 0.344), (64, 0.128), (256, 0.041), (1024, 0.0162), (4096, 0.0085)]),
-                (1.0, vec![(16, 0.366), (64, 0.148), (256, 0.057), (1024, 0.0275), (4096, 0.0154)]),
+                (0.035, vec![(16, 0.0618), (64, 0.0592), (256, 0.0586)]),
+                (0.075, vec![(16, 0.357), (64, 0.359), (256, 0.357)]),
+                (0.15, vec![(16, 0.0987), (64, 0.122), (256, 0.104)]),
+                (0.275, vec![(16, 0.0998), (64, 0.0699), (256, 0.0596)]),
+                (0.425, vec![(16, 0.0696), (64, 0.0527), (256, 0.0484)]),
+                (0.625, vec![(16, 0.0411), (64, 0.0247), (256, 0.0245)]),
+                (0.875, vec![(16, 0.0383), (64, 0.0353), (256, 0.0269)]),
             ],
             irradiance: vec![(4, 0.035), (8, 0.0181), (16, 0.0067), (32, 0.00168), (64, 0.00083)],
-            ns: [(139.0, 46.0), (143.0, 97.0), (3.8, 14.7), (21.7, 25.0)],
+            // Rates from `runner bench` of the defaults on city.exr: 12.2 M prefilter samples in
+            // 0.51 s / 0.82 s, 36 M table evaluations (quadrature) in 0.12 s / 0.33 s, 9.4 M
+            // irradiance texel pairs in 0.077 s / 0.156 s.
+            ns: [(139.0, 46.0), (41.5, 67.0), (3.3, 9.1), (8.2, 16.5)],
         }
     }
+}
+
+/// A `report.csv` row of the end-to-end measure's bake share for the defaults at some
+/// sample count: product `shaded colour r in [a, b): (a) bake`, setting `defaults` or
+/// `defaults, N samples`; gives the band's middle and `N`.
+fn bake_share(product: &str, setting: &str) -> Option<(f32, u32)> {
+    let band = product.strip_prefix("shaded colour r in [")?.strip_suffix(": (a) bake")?;
+    let (a, rest) = band.split_once(", ")?;
+    let b = rest.trim_end_matches([')', ']']);
+    let (a, b): (f32, f32) = (a.parse().ok()?, b.parse().ok()?);
+    let n = if setting == "defaults" { Settings::default().samples } else { setting.strip_prefix("defaults, ")?.strip_suffix(" samples")?.parse().ok()? };
+    Some((0.5 * (a + b), n))
 }
 
 impl Calibration {
@@ -84,10 +109,12 @@ impl Calibration {
                 }
             } else if f[0] == "irradiance (convolution)" {
                 c.irradiance.push((first_number(&f[2])?, err));
-            } else if let Some(r) = f[0].strip_prefix("prefilter r=").and_then(|r| r.parse::<f32>().ok()) {
-                let n = first_number(&f[2])?;
+            } else if let Some((r, n)) = bake_share(&f[0], &f[2]) {
                 match c.prefilter.iter_mut().find(|(x, _)| (*x - r).abs() < 1e-3) {
-                    Some((_, v)) => v.push((n, err)),
+                    Some((_, v)) => {
+                        v.push((n, err));
+                        v.sort_by_key(|&(n, _)| n);
+                    }
                     None => c.prefilter.push((r, vec![(n, err)])),
                 }
             }
@@ -95,6 +122,8 @@ impl Calibration {
         (!c.lut.is_empty() && !c.prefilter.is_empty() && !c.irradiance.is_empty()).then_some(c)
     }
 
+    /// The bake's share of the shaded colour's error at `roughness` (the nearest band) with
+    /// `samples` at mip 1.
     fn prefilter_error(&self, roughness: f32, samples: u32) -> f64 {
         // The measured roughness nearest to the one asked for.
         let table = &self.prefilter.iter().min_by(|a, b| (a.0 - roughness).abs().total_cmp(&(b.0 - roughness).abs())).expect("calibrated").1;
@@ -304,7 +333,16 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
 
     // Samples, bias, table, irradiance source.
     settings.lod_bias = q.lod_bias.unwrap_or(settings.lod_bias);
-    let needed_r: Vec<f32> = levels.iter().map(|&l| roughness_of(l)).filter(|&r| r > 0.0).collect();
+    // The roughness the scene's specular materials read: the ends of each range and every
+    // calibrated band's middle inside it (a blurred sky reads its mip's roughness).
+    let mut needed_r: Vec<f32> = Vec::new();
+    for m in &specular_ibl {
+        let (a, b) = m.roughness.range();
+        needed_r.extend([a, b].into_iter().chain(cal.prefilter.iter().map(|p| p.0).filter(|&r| r >= a && r <= b)).filter(|&r| r > 0.0));
+    }
+    if needed_r.is_empty() {
+        needed_r = levels.iter().map(|&l| roughness_of(l)).filter(|&r| r > 0.0).collect();
+    }
     settings.samples = match (q.samples, target) {
         (Some(n), _) => n,
         (None, Some(e)) if specular => {

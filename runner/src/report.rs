@@ -397,7 +397,7 @@ fn lut_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References) -> Res
     // The deterministic quadrature (the default table), on the same texels.
     let (table, ms) = timed(|| backend.brdf_table(sweep.lut_size, splitsum_shaders::brdf::microfacet::Masking::SmithSchlick))?;
     let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
-    rows.push(Measurement::of("brdf lut", b, "quadrature", ms, &errors, ABS));
+    rows.push(Measurement::of("brdf lut (quadrature)", b, format!("{0}x{0}", sweep.lut_size), ms, &errors, ABS));
     let n = *sweep.samples.last().expect("samples");
     for &size in &sweep.lut_sizes {
         let (table, ms) = timed(|| backend.brdf_lut(size, n))?;
