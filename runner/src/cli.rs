@@ -524,16 +524,20 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
     settings.validate()?;
     let (env, _) = environment::load(&args.env, false)?;
     println!(
-        "bench: {} at size {}, {} mips, {} samples/texel, irradiance {}² from {}², SH9 from {}², LUT {}² × {}",
+        "bench: {} at size {}, {} mips ({:?}), {:?} samples per mip, irradiance {}² from {}², SH9 from {}², table {}² {}",
         args.env.display(),
         settings.size,
         settings.mips,
-        settings.samples,
+        settings.mapping,
+        settings.samples_per_mip(),
         settings.irradiance_size,
         settings.irradiance_source,
         settings.sh_source,
         settings.lut_size,
-        settings.lut_samples
+        match settings.lut_method {
+            TableMethod::Quadrature => format!("by quadrature ({:?})", settings.lut_masking),
+            TableMethod::Sampled => format!("× {} samples", settings.lut_samples),
+        }
     );
     for kind in &args.backends {
         let backend = match Backend::open(*kind) {

@@ -175,13 +175,28 @@ impl ViewState {
 
     /// A one-line summary of the choices (the window title).
     pub fn summary(&self) -> String {
+        /// The image-based light's options, as ` (a, b)`, or nothing.
+        fn ibl_options(flags: u32) -> String {
+            let names: Vec<&str> = [
+                (ShadeOptions::DOMINANT_DIRECTION, "dominant direction"),
+                (ShadeOptions::MULTISCATTER, "multiple scattering"),
+                (ShadeOptions::FILTERED_SAMPLING, "filtered"),
+                (ShadeOptions::CORRELATED_SMITH, "exact Smith for lights"),
+            ]
+            .iter()
+            .filter(|(bit, _)| flags & bit != 0)
+            .map(|&(_, name)| name)
+            .collect();
+            if names.is_empty() { String::new() } else { format!(" ({})", names.join(", ")) }
+        }
         let o = self.options;
         format!(
-            "diffuse {} | specular {} | Fresnel {} | IBL {} | lights {} | exposure {:.2} | {} | sky blur {:.1}{}",
+            "diffuse {} | specular {} | Fresnel {} | IBL {}{} | lights {} | exposure {:.2} | {} | sky blur {:.1}{}",
             diffuse_name(o.diffuse),
             specular_name(o.specular),
             fresnel_name(o.fresnel),
             if o.flags & ShadeOptions::IBL != 0 { "on" } else { "off" },
+            ibl_options(o.flags),
             if o.flags & ShadeOptions::DIRECT != 0 { "on" } else { "off" },
             self.exposure,
             tonemapper_name(self.tonemapper),
