@@ -250,6 +250,7 @@ pub fn seed_settings(source_size: u32) -> Settings {
         mapping: bake::Mapping::Linear,
         samples: 1024,
         sample_growth: 1,
+        exact_sums: false,
         lod_bias: 0.5,
         lut_method: bake::TableMethod::Sampled,
         lut_masking: MaskingModel::Schlick,

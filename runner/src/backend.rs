@@ -217,17 +217,31 @@ impl Backend {
     /// `roughness[m]` with `samples` GGX samples and source-level bias `lod_bias`.
     pub fn prefilter(&self, src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Result<Cube> {
         let all: Vec<u32> = (0..out.levels).collect();
-        self.prefilter_levels(src, out, roughness, &all, &vec![samples; out.levels as usize], lod_bias)
+        self.prefilter_levels(src, out, roughness, &all, &vec![samples; out.levels as usize], false, lod_bias)
     }
 
     /// As [`Backend::prefilter`], baking only `levels` (the other levels stay zero: a plan
-    /// leaves out what nothing reads), level `m` from `samples[m]` GGX samples.
-    pub fn prefilter_levels(&self, src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32], samples: &[u32], lod_bias: f32) -> Result<Cube> {
+    /// leaves out what nothing reads), level `m` from `samples[m]` GGX samples, or with
+    /// `exact` summed exactly over a source level where that is cheaper
+    /// (`prefilter::exact_level`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn prefilter_levels(
+        &self,
+        src: &Cube,
+        out: CubeLayout,
+        roughness: &[f32],
+        levels: &[u32],
+        samples: &[u32],
+        exact: bool,
+        lod_bias: f32,
+    ) -> Result<Cube> {
         if samples.contains(&0) {
             return Err(Error::Invalid("--samples must be at least 1".into()));
         }
+        let exact_levels: Vec<u32> =
+            roughness.iter().zip(samples).map(|(&r, &n)| if exact { prefilter::exact_level(r, n, src.layout) } else { prefilter::SAMPLED }).collect();
         let g = match self {
-            Backend::Cpu => return Ok(cpu::prefilter(src, out, roughness, levels, samples, lod_bias)),
+            Backend::Cpu => return Ok(cpu::prefilter(src, out, roughness, levels, samples, &exact_levels, lod_bias)),
             Backend::Gpu(g) => g,
         };
         let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
@@ -239,7 +253,10 @@ impl Backend {
             }
             let s = out.level_size(m);
             let t = gpu::groups(s, kernels::TILE);
-            for (start, count) in chunks(samples) {
+            let exact_level = exact_levels[m as usize];
+            // An exact sum runs over every texel of its source level, in chunks.
+            let terms = if exact_level == prefilter::SAMPLED { samples } else { FACES * src.layout.level_size(exact_level).pow(2) };
+            for (start, count) in chunks(terms) {
                 let p = PrefilterParams {
                     src_size: src.layout.size,
                     src_levels: src.layout.levels,
@@ -250,7 +267,7 @@ impl Backend {
                     dst_offset: out.level_offset(m),
                     start,
                     count,
-                    pad0: 0,
+                    exact_level,
                     pad1: 0,
                     pad2: 0,
                 };
@@ -276,7 +293,7 @@ impl Backend {
                 for y in 0..s {
                     for x in 0..s {
                         texels.push(if r <= 0.0 {
-                            prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples[m as usize], lod_bias)
+                            prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, samples[m as usize], lod_bias, prefilter::SAMPLED)
                         } else {
                             partial(&sums, out.index(m, face, x, y) as usize).resolve()
                         });

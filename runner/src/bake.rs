@@ -92,6 +92,9 @@ pub struct Settings {
     /// every mip, the seed method). Mips shrink by 4 in texels, so a factor up to 4 keeps
     /// each mip's cost at most mip 1's, and rough lobes need the samples.
     pub sample_growth: u32,
+    /// Sum a rough mip exactly over a coarse source level where that costs less than its
+    /// samples (`prefilter::exact_level`); false: sample every mip (the seed method).
+    pub exact_sums: bool,
     /// Added to the source level each prefilter sample reads (`½·log₂(Ωs/Ωp) + bias`).
     pub lod_bias: f32,
     /// Supersampling density of the equirect → cube resampling (points per source texel
@@ -124,6 +127,7 @@ impl Default for Settings {
             mapping: Mapping::Geometric,
             samples: 64,
             sample_growth: 2,
+            exact_sums: true,
             lod_bias: 0.5,
             supersample_density: 2.0,
             irradiance_size: 32,
@@ -310,7 +314,15 @@ pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products:
     let specular = if products.specular {
         Some(timed(&mut timings, "specular", || {
             let all: Vec<u32> = (0..settings.mips).collect();
-            backend.prefilter_levels(&source, settings.specular_layout(), &settings.roughness(), &all, &settings.samples_per_mip(), settings.lod_bias)
+            backend.prefilter_levels(
+                &source,
+                settings.specular_layout(),
+                &settings.roughness(),
+                &all,
+                &settings.samples_per_mip(),
+                settings.exact_sums,
+                settings.lod_bias,
+            )
         })?)
     } else {
         None
@@ -574,7 +586,7 @@ pub fn bake_plan(backend: &Backend, env: &Environment, plan: &crate::plan::Plan)
     let source = timed(&mut timings, "source cube", || source_cube(backend, env, s))?;
     let specular = if plan.products.specular {
         timed(&mut timings, "specular", || {
-            backend.prefilter_levels(&source, s.specular_layout(), &s.roughness(), &plan.levels, &s.samples_per_mip(), s.lod_bias)
+            backend.prefilter_levels(&source, s.specular_layout(), &s.roughness(), &plan.levels, &s.samples_per_mip(), s.exact_sums, s.lod_bias)
         })?
     } else {
         empty_cube()

@@ -284,6 +284,10 @@ pub struct QualityArgs {
     /// Factor by which the sample count grows per mip after mip 1 (1 = the same on every mip).
     #[arg(long, default_value_t = 2)]
     pub sample_growth: u32,
+    /// Sample every mip, even the rough ones that an exact sum over a coarse source level
+    /// would bake for less.
+    #[arg(long)]
+    pub sampled_only: bool,
     /// Bias added to the source mip each prefilter sample reads (0.5: the best error at 1024
     /// samples in `runner report`, on city.exr's sun and on courtyard.exr).
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
@@ -330,6 +334,7 @@ impl QualityArgs {
             mapping: self.mapping,
             samples: self.samples,
             sample_growth: self.sample_growth,
+            exact_sums: !self.sampled_only,
             lod_bias: self.lod_bias,
             supersample_density: self.supersample,
             irradiance_size: self.irradiance_size,

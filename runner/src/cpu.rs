@@ -112,8 +112,9 @@ pub fn build_mips(cube: &mut Cube) {
 }
 
 /// Levels `levels` of the prefiltered specular cube (the others stay zero).
-/// The prefiltered cube: level `m` (of `levels`) for `roughness[m]` from `samples[m]` GGX samples.
-pub fn prefilter(src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32], samples: &[u32], lod_bias: f32) -> Cube {
+/// The prefiltered cube: level `m` (of `levels`) for `roughness[m]` from `samples[m]` GGX
+/// samples, or summed exactly over source level `exact[m]` (unless `prefilter::SAMPLED`).
+pub fn prefilter(src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32], samples: &[u32], exact: &[u32], lod_bias: f32) -> Cube {
     let mut texels = vec![Vec4::ZERO; out.texel_count() as usize];
     let rows: u64 = levels.iter().map(|&m| (FACES * out.level_size(m)) as u64).sum();
     let bar = progress("specular", rows);
@@ -121,8 +122,8 @@ pub fn prefilter(src: &Cube, out: CubeLayout, roughness: &[f32], levels: &[u32],
         let s = out.level_size(m);
         let start = out.level_offset(m) as usize;
         let level = &mut texels[start..start + (FACES * s * s) as usize];
-        let (r, n) = (roughness[m as usize], samples[m as usize]);
-        fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, n, lod_bias));
+        let (r, n, e) = (roughness[m as usize], samples[m as usize], exact[m as usize]);
+        fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(&src.texels, src.layout, face, x, y, s, r, n, lod_bias, e));
     }
     bar.finish_and_clear();
     Cube { layout: out, texels }

@@ -412,8 +412,16 @@ pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, ca
         let samples = s.samples_per_mip();
         for &l in levels {
             let texels = 6.0 * (out.level_size(l) as f64).powi(2);
-            if mapping.roughness(l, s.mips) > 0.0 {
-                work[1] += texels * samples[l as usize] as f64;
+            let r = mapping.roughness(l, s.mips);
+            if r > 0.0 {
+                let n = samples[l as usize];
+                // An exact sum's 6t² terms cost about an eighth of a sample each.
+                let per_texel = if s.exact_sums && splitsum_shaders::prefilter::prefers_exact(r, n, s.source_size) {
+                    6.0 * (splitsum_shaders::prefilter::exact_source_size(r, s.source_size) as f64).powi(2) / 8.0
+                } else {
+                    n as f64
+                };
+                work[1] += texels * per_texel;
             }
             bytes += texels as u64 * 16;
         }

@@ -23,7 +23,7 @@
 //! triangle is exactly `Δ²` (`Δ = 2/s`), so the formula has no cancellation even for tiny
 //! texels.
 
-use crate::math;
+use crate::math::{self, CompensatedSum, CompensatedSum4, MeanPartial};
 use spirv_std::glam::{Vec2, Vec3, Vec4};
 
 /// Number of faces of a cube map.
@@ -272,4 +272,40 @@ pub fn downsample_texel(texels: &[Vec4], layout: CubeLayout, level: u32, face: u
         k += 1;
     }
     math::finite4(acc)
+}
+
+/// Adds texels `start .. start + count` of `level` (numbered face by face, row by row) to
+/// the weighted mean `p`, each weighted by `weight(direction, solid angle)` (zero or
+/// negative weights skip the texel): the exact sums of the irradiance convolution and of the
+/// exact prefilter, with compensated running sums carried from chunk to chunk.
+#[inline]
+pub fn weighted_level_sum(
+    src: &[Vec4],
+    layout: CubeLayout,
+    level: u32,
+    start: u32,
+    count: u32,
+    p: MeanPartial,
+    weight: impl Fn(Vec3, f32) -> f32,
+) -> MeanPartial {
+    let s = layout.level_size(level);
+    let base = layout.level_offset(level);
+    let mut acc = CompensatedSum4::resume(p.sum, p.carry);
+    let mut wsum = CompensatedSum::resume(p.weight.x, p.weight.y);
+    let mut t = start;
+    let end = start + count;
+    while t < end {
+        let face = t / (s * s);
+        let y = (t / s) % s;
+        let x = t % s;
+        let w = weight(texel_dir(face, x, y, s), texel_solid_angle(x, y, s));
+        if w > 0.0 {
+            acc.add(src[(base + t) as usize] * w);
+            wsum.add(w);
+        }
+        t += 1;
+    }
+    let (sum, carry) = acc.parts();
+    let (w, wc) = wsum.parts();
+    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
 }

@@ -16,7 +16,7 @@
 //! `E(n)/π = Σ (Âₗ/π) L_lm Y_lm(n)` with `Âₗ/π = 1, 2/3, 1/4` for `l = 0, 1, 2`.
 
 use crate::cubemap::{self, CubeLayout};
-use crate::math::{self, CompensatedSum, CompensatedSum4, MeanPartial};
+use crate::math::{self, MeanPartial};
 use spirv_std::glam::{Vec3, Vec4};
 
 /// Number of SH coefficients up to band 2.
@@ -76,28 +76,8 @@ pub fn convolve_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3) -> Ve
 pub fn accumulate(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
     // A zero or non-finite normal is read as +z: never an empty hemisphere, never NaN.
     let n = crate::sampling::normalize_or(n, Vec3::Z);
-    let s = layout.level_size(level);
-    let base = layout.level_offset(level);
-    let mut acc = CompensatedSum4::resume(p.sum, p.carry);
-    let mut wsum = CompensatedSum::resume(p.weight.x, p.weight.y);
-    let mut t = start;
-    let end = start + count;
-    while t < end {
-        let face = t / (s * s);
-        let y = (t / s) % s;
-        let x = t % s;
-        let c = n.dot(cubemap::texel_dir(face, x, y, s));
-        if c > 0.0 {
-            // Scaled by 1/(4π) so the weights sum to about 1/4: no overflow.
-            let w = c * cubemap::texel_solid_angle(x, y, s) * (0.25 * math::FRAC_1_PI);
-            acc.add(src[(base + t) as usize] * w);
-            wsum.add(w);
-        }
-        t += 1;
-    }
-    let (sum, carry) = acc.parts();
-    let (w, wc) = wsum.parts();
-    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
+    // Scaled by 1/(4π) so the weights sum to about 1/4: no overflow.
+    cubemap::weighted_level_sum(src, layout, level, start, count, p, |d, omega| math::max(n.dot(d), 0.0) * omega * (0.25 * math::FRAC_1_PI))
 }
 
 /// The contribution of row `y` of `face` of `level` to the SH projection: nine RGB

@@ -189,10 +189,11 @@ pub struct PrefilterParams {
     pub dst_offset: u32,
     /// First sample of this dispatch's chunk.
     pub start: u32,
-    /// Samples in this chunk (at most `math::CHUNK`).
+    /// Samples in this chunk (at most `math::CHUNK`), or source texels for an exact sum.
     pub count: u32,
-    /// Unused; keeps the block a multiple of 16 bytes.
-    pub pad0: u32,
+    /// The source level summed exactly (`prefilter::exact_accumulate`), or
+    /// `prefilter::SAMPLED`.
+    pub exact_level: u32,
     /// Unused.
     pub pad1: u32,
     /// Unused.
@@ -229,7 +230,11 @@ pub fn prefilter_specular(
         let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
         let n = cubemap::texel_dir(id.z, id.x, id.y, s);
         let partial = load_partial(accum, i);
-        let next = prefilter::accumulate(src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial);
+        let next = if p.exact_level == prefilter::SAMPLED {
+            prefilter::accumulate(src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial)
+        } else {
+            prefilter::exact_accumulate(src, layout, p.exact_level, n, p.roughness, p.start, p.count, partial)
+        };
         store_partial(accum, i, next);
     }
 }

@@ -15,6 +15,13 @@
 //!
 //! **Roughness 0** is a mirror: the result is the source itself (copied exactly where the
 //! output level has the source's resolution).
+//!
+//! **Exact sums for rough mips.** A rough lobe spans many texels of a coarse source level,
+//! so the same mean can be summed exactly over every texel of that level,
+//! `L̃ = Σⱼ Lⱼ D(hⱼ)(n·lⱼ)Ωⱼ / Σⱼ D(hⱼ)(n·lⱼ)Ωⱼ`, `hⱼ = (n + lⱼ)/|n + lⱼ|`, with no sampling
+//! noise. [`exact_source_size`] picks the level (eight texels per `α`), and [`prefers_exact`]
+//! takes the exact sum where its `6t²` terms cost less than the samples (a sample costs
+//! about eight texel terms: a trilinear lookup and the GGX terms).
 
 use crate::brdf::{alpha_from_roughness, microfacet};
 use crate::cubemap::{self, CubeLayout};
@@ -184,14 +191,104 @@ pub fn mirror_texel(src: &[Vec4], layout: CubeLayout, face: u32, x: u32, y: u32,
 }
 
 /// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`: the source
-/// texel itself at roughness 0 ([`mirror_texel`]), else [`prefilter_dir`] at the texel
-/// centre.
-pub fn prefilter_texel(src: &[Vec4], layout: CubeLayout, face: u32, x: u32, y: u32, dst_size: u32, roughness: f32, samples: u32, lod_bias: f32) -> Vec4 {
+/// texel itself at roughness 0 ([`mirror_texel`]), the exact sum over source level
+/// `exact_level` ([`exact_dir`]) unless that is [`SAMPLED`], else [`prefilter_dir`] at the
+/// texel centre.
+#[allow(clippy::too_many_arguments)]
+pub fn prefilter_texel(
+    src: &[Vec4],
+    layout: CubeLayout,
+    face: u32,
+    x: u32,
+    y: u32,
+    dst_size: u32,
+    roughness: f32,
+    samples: u32,
+    lod_bias: f32,
+    exact_level: u32,
+) -> Vec4 {
     if roughness <= 0.0 {
         if let Some(t) = mirror_texel(src, layout, face, x, y, dst_size) {
             return t;
         }
     }
     let n = cubemap::texel_dir(face, x, y, dst_size);
+    if exact_level != SAMPLED {
+        return exact_dir(src, layout, exact_level, n, roughness);
+    }
     prefilter_dir(src, layout, n, roughness, samples, lod_bias)
+}
+
+/// `PrefilterParams::exact_level` of a level that is sampled, not summed exactly.
+pub const SAMPLED: u32 = u32::MAX;
+
+/// Face size of the source level an exact sum for `roughness` runs over: the smallest power
+/// of two whose texel (`π/(2t)` radians) is at most `α/8`, at most `src_size` (at `α/4` a
+/// texel-wide sun moved to its coarse texel's centre still shifted `r = 1` by 10 % on
+/// city.exr).
+#[inline]
+pub fn exact_source_size(roughness: f32, src_size: u32) -> u32 {
+    let alpha = alpha_from_roughness(math::saturate(roughness));
+    let mut t = 1u32;
+    while t < src_size && math::PI / (2.0 * t as f32) > 0.125 * alpha {
+        t *= 2;
+    }
+    t
+}
+
+/// Whether a level of `roughness` with `samples` GGX samples per texel is cheaper summed
+/// exactly over [`exact_source_size`] (`6t²` terms) than sampled (about 8 terms a sample).
+#[inline]
+pub fn prefers_exact(roughness: f32, samples: u32, src_size: u32) -> bool {
+    let t = exact_source_size(roughness, src_size);
+    roughness > 0.0 && 6 * t * t <= 8 * samples
+}
+
+/// The source level (of `layout`) that a level of `roughness` with `samples` GGX samples
+/// per texel is summed over exactly, or [`SAMPLED`] where sampling is cheaper
+/// ([`prefers_exact`]).
+#[inline]
+pub fn exact_level(roughness: f32, samples: u32, layout: CubeLayout) -> u32 {
+    if !prefers_exact(roughness, samples, layout.size) {
+        return SAMPLED;
+    }
+    let t = exact_source_size(roughness, layout.size);
+    let mut level = 0;
+    while level + 1 < layout.levels && layout.level_size(level) > t {
+        level += 1;
+    }
+    level
+}
+
+/// Adds texels `start .. start + count` of source level `level` to the exact GGX-weighted
+/// mean for direction `n` and `roughness` (see the module header).
+pub fn exact_accumulate(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
+    let n = sampling::normalize_or(n, Vec3::Z);
+    let alpha = alpha_from_roughness(math::saturate(roughness));
+    // D ≤ 1/(πα²) and Ω ≤ 4π/6: scaled by α² so no weight exceeds about 1.
+    let scale = alpha * alpha;
+    cubemap::weighted_level_sum(src, layout, level, start, count, p, |l, omega| {
+        let n_dot_l = n.dot(l);
+        if n_dot_l > 0.0 {
+            let h = sampling::normalize_or(n + l, n);
+            microfacet::d_ggx_vec(n, h, alpha) * scale * n_dot_l * omega
+        } else {
+            0.0
+        }
+    })
+}
+
+/// The exact GGX-weighted mean over every texel of `level` (see [`exact_accumulate`]),
+/// chunked as the GPU runs it.
+pub fn exact_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32) -> Vec4 {
+    let s = layout.level_size(level);
+    let total = cubemap::FACES * s * s;
+    let mut p = MeanPartial::default();
+    let mut start = 0u32;
+    while start < total {
+        let c = if total - start < math::CHUNK { total - start } else { math::CHUNK };
+        p = exact_accumulate(src, layout, level, n, roughness, start, c, p);
+        start += c;
+    }
+    p.resolve()
 }
