@@ -102,17 +102,7 @@ fn brdf_lut_part(n_dot_v: f64, roughness: f64, tol: f64, bias: bool, smith: Smit
 /// Unit direction of texel `(x, y)` of `face` (size `s`), in f64, from the face table of
 /// OpenGL 4.6 §8.13 (major axis, s_c, t_c) inverted by hand.
 pub fn texel_dir(face: u32, x: u32, y: u32, s: u32) -> [f64; 3] {
-    let a = 2.0 * (x as f64 + 0.5) / s as f64 - 1.0;
-    let b = 2.0 * (y as f64 + 0.5) / s as f64 - 1.0;
-    let d = match face {
-        0 => [1.0, -b, -a],
-        1 => [-1.0, -b, a],
-        2 => [a, 1.0, b],
-        3 => [a, -1.0, -b],
-        4 => [a, -b, 1.0],
-        _ => [-a, -b, -1.0],
-    };
-    normalize(d)
+    face_dir(face, 2.0 * (x as f64 + 0.5) / s as f64 - 1.0, 2.0 * (y as f64 + 0.5) / s as f64 - 1.0)
 }
 
 /// `d / |d|`.
@@ -259,7 +249,7 @@ pub struct Environment {
 }
 
 /// The direction through face coordinates `(a, b)` ∈ [−1, 1]² of `face` (OpenGL 4.6
-/// §8.13, inverted by hand; the same table as [`texel_dir`]).
+/// §8.13, major axis, s_c, t_c, inverted by hand).
 fn face_dir(face: u32, a: f64, b: f64) -> [f64; 3] {
     normalize(match face {
         0 => [1.0, -b, -a],

@@ -19,13 +19,13 @@ pub fn progress(what: &str, len: u64) -> ProgressBar {
     bar
 }
 
-/// The BRDF table, one rayon task per row.
-pub fn brdf_lut(size: u32, samples: u32) -> Lut {
-    let bar = progress("brdf lut", size as u64);
+/// A `size`×`size` table, `f(x, y)` per texel, one rayon task per row.
+fn table(what: &str, size: u32, f: impl Fn(u32, u32) -> Vec2 + Sync) -> Lut {
+    let bar = progress(what, size as u64);
     let mut texels = vec![Vec2::ZERO; (size * size) as usize];
     texels.par_chunks_mut(size as usize).enumerate().for_each(|(y, row)| {
         for (x, t) in row.iter_mut().enumerate() {
-            *t = lut::texel(x as u32, y as u32, size, samples);
+            *t = f(x as u32, y as u32);
         }
         bar.inc(1);
     });
@@ -33,18 +33,14 @@ pub fn brdf_lut(size: u32, samples: u32) -> Lut {
     Lut { size, texels }
 }
 
-/// The BRDF table by quadrature, one rayon task per row.
+/// The BRDF table from `samples` Hammersley points per texel.
+pub fn brdf_lut(size: u32, samples: u32) -> Lut {
+    table("brdf lut", size, |x, y| lut::texel(x, y, size, samples))
+}
+
+/// The BRDF table by quadrature.
 pub fn brdf_table(size: u32, masking: splitsum_shaders::brdf::microfacet::Masking) -> Lut {
-    let bar = progress("brdf table", size as u64);
-    let mut texels = vec![Vec2::ZERO; (size * size) as usize];
-    texels.par_chunks_mut(size as usize).enumerate().for_each(|(y, row)| {
-        for (x, t) in row.iter_mut().enumerate() {
-            *t = lut::texel_quadrature(x as u32, y as u32, size, masking);
-        }
-        bar.inc(1);
-    });
-    bar.finish_and_clear();
-    Lut { size, texels }
+    table("brdf table", size, |x, y| lut::texel_quadrature(x, y, size, masking))
 }
 
 /// Fills the rows of one cube level, `f(face, x, y)` per texel, in parallel.

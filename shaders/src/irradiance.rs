@@ -60,15 +60,7 @@ pub fn sh9_irradiance(coeffs: &[Vec4; SH9], n: Vec3) -> Vec3 {
 /// the source cube: [`accumulate`] over chunks of `math::CHUNK` texels, then the mean.
 pub fn convolve_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3) -> Vec4 {
     let s = layout.level_size(level);
-    let total = cubemap::FACES * s * s;
-    let mut p = MeanPartial::default();
-    let mut start = 0u32;
-    while start < total {
-        let c = if total - start < math::CHUNK { total - start } else { math::CHUNK };
-        p = accumulate(src, layout, level, n, start, c, p);
-        start += c;
-    }
-    p.resolve()
+    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| accumulate(src, layout, level, n, start, c, p))
 }
 
 /// Adds texels `start .. start + count` of `level` (numbered face by face, row by row) to

@@ -389,4 +389,19 @@ impl MeanPartial {
     pub fn resolve(&self) -> Vec4 {
         if self.weight.x > 0.0 { finite4(self.sum / self.weight.x) } else { Vec4::ZERO }
     }
+
+    /// The mean of a sum of `terms` terms run as `add(start, count, partial)` over chunks of
+    /// [`CHUNK`], in the order the GPU's dispatches run them. For the CPU paths: in a
+    /// shader, a closure that holds a storage-buffer slice does not validate (naga).
+    #[inline]
+    pub fn chunked(terms: u32, add: impl Fn(u32, u32, MeanPartial) -> MeanPartial) -> Vec4 {
+        let mut p = MeanPartial::default();
+        let mut start = 0u32;
+        while start < terms {
+            let c = if terms - start < CHUNK { terms - start } else { CHUNK };
+            p = add(start, c, p);
+            start += c;
+        }
+        p.resolve()
+    }
 }

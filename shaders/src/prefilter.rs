@@ -123,6 +123,9 @@ pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, 
         return cubemap::sample_bilinear(src, layout, 0, sampling::normalize_or(n, Vec3::Z));
     }
     let count = samples.max(1);
+    // An explicit loop, not `MeanPartial::chunked`: the display's fragment shader calls
+    // this (filtered sampling), and a closure holding the storage-buffer slice becomes a
+    // struct of a runtime array, which naga rejects ("Expected data type").
     let mut p = MeanPartial::default();
     let mut start = 0u32;
     while start < count {
@@ -282,13 +285,5 @@ pub fn exact_accumulate(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, r
 /// chunked as the GPU runs it.
 pub fn exact_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32) -> Vec4 {
     let s = layout.level_size(level);
-    let total = cubemap::FACES * s * s;
-    let mut p = MeanPartial::default();
-    let mut start = 0u32;
-    while start < total {
-        let c = if total - start < math::CHUNK { total - start } else { math::CHUNK };
-        p = exact_accumulate(src, layout, level, n, roughness, start, c, p);
-        start += c;
-    }
-    p.resolve()
+    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| exact_accumulate(src, layout, level, n, roughness, start, c, p))
 }
