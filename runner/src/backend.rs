@@ -46,6 +46,27 @@ fn read_vec4(g: &Gpu, buffer: &wgpu::Buffer, count: u32) -> Result<Vec<Vec4>> {
     Ok(bytemuck::pod_collect_to_vec(&bytes[..count as usize * 16]))
 }
 
+/// Runs a table kernel over the rows of a `size`×`size` table, `per_texel` integrand
+/// evaluations a texel, with the parameters `params(first row)`: about 2²⁶ evaluations per
+/// submission, so that none runs long enough to trip a display driver's watchdog.
+fn table_rows<P: bytemuck::Pod>(g: &Gpu, kernel: Kernel, size: u32, per_texel: u32, output: &wgpu::Buffer, params: impl Fn(u32) -> P) {
+    let rows = ((1u64 << 26) / (size as u64 * per_texel.max(1) as u64)).clamp(1, size as u64) as u32;
+    let rows = rows.div_ceil(kernels::TILE) * kernels::TILE;
+    let mut row = 0;
+    while row < size {
+        let p = params(row);
+        let h = rows.min(size - row);
+        g.run(&[Dispatch {
+            kernel,
+            params: bytemuck::bytes_of(&p),
+            input: None,
+            output,
+            groups: [gpu::groups(size, kernels::TILE), gpu::groups(h, kernels::TILE), 1],
+        }]);
+        row += h;
+    }
+}
+
 fn partial(sums: &[Vec4], texel: usize) -> MeanPartial {
     MeanPartial { sum: sums[3 * texel], carry: sums[3 * texel + 1], weight: sums[3 * texel + 2] }
 }
@@ -89,25 +110,8 @@ impl Backend {
         };
         let n = size as u64 * size as u64;
         let accum = g.output("brdf lut sums", n * 16)?;
-        // Rows per submission: about 2²⁶ sample evaluations each, so that no single
-        // submission runs long enough to trip a display driver's watchdog.
-        let per_row = size as u64 * samples.min(CHUNK) as u64;
-        let rows = ((1u64 << 26) / per_row).clamp(1, size as u64) as u32;
-        let rows = rows.div_ceil(kernels::TILE) * kernels::TILE;
         for (start, count) in chunks(samples) {
-            let mut row = 0;
-            while row < size {
-                let p = LutParams { size, samples, row_offset: row, start, count, pad0: 0, pad1: 0, pad2: 0 };
-                let h = rows.min(size - row);
-                g.run(&[Dispatch {
-                    kernel: Kernel::BrdfLut,
-                    params: bytemuck::bytes_of(&p),
-                    input: None,
-                    output: &accum,
-                    groups: [gpu::groups(size, kernels::TILE), gpu::groups(h, kernels::TILE), 1],
-                }]);
-                row += h;
-            }
+            table_rows(g, Kernel::BrdfLut, size, count, &accum, |row_offset| LutParams { size, samples, row_offset, start, count, pad0: 0, pad1: 0, pad2: 0 });
         }
         let sums = read_vec4(g, &accum, n as u32)?;
         Ok(Lut { size, texels: sums.iter().map(|&st| lut::resolve(st, samples)).collect() })
@@ -123,23 +127,8 @@ impl Backend {
         };
         let n = size as u64 * size as u64;
         let out = g.output("brdf table", n * 16)?;
-        // Rows per submission: about 2²⁶ integrand evaluations (some 550 per texel), so
-        // that no submission runs long enough to trip a display driver's watchdog.
-        let rows = ((1u64 << 26) / (size as u64 * 512)).clamp(1, size as u64) as u32;
-        let rows = rows.div_ceil(kernels::TILE) * kernels::TILE;
-        let mut row = 0;
-        while row < size {
-            let p = TableParams { size, masking: masking as u32, row_offset: row, pad: 0 };
-            let h = rows.min(size - row);
-            g.run(&[Dispatch {
-                kernel: Kernel::BrdfTable,
-                params: bytemuck::bytes_of(&p),
-                input: None,
-                output: &out,
-                groups: [gpu::groups(size, kernels::TILE), gpu::groups(h, kernels::TILE), 1],
-            }]);
-            row += h;
-        }
+        let per_texel = splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS;
+        table_rows(g, Kernel::BrdfTable, size, per_texel, &out, |row_offset| TableParams { size, masking: masking as u32, row_offset, pad: 0 });
         let texels = read_vec4(g, &out, n as u32)?;
         Ok(Lut { size, texels: texels.iter().map(|t| t.truncate().truncate()).collect() })
     }
