@@ -28,7 +28,7 @@ use crate::backend::Backend;
 use crate::bake::{self, MaskingModel, Products, Settings};
 use crate::environment::Environment;
 use crate::error::Result;
-use crate::report::{Measurement, REL};
+use crate::measurement::{Measurement, REL, arr, rel, rel64};
 use crate::texture::Cube;
 use rayon::prelude::*;
 use splitsum_reference as reference;
@@ -110,21 +110,8 @@ pub struct Points {
     pub source_size: u32,
 }
 
-fn arr(v: Vec3) -> [f64; 3] {
-    [v.x as f64, v.y as f64, v.z as f64]
-}
-
 fn vec(c: [f64; 3]) -> Vec3 {
     Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)
-}
-
-fn rel(got: Vec3, want: [f64; 3]) -> f64 {
-    rel64(arr(got), want)
-}
-
-fn rel64(got: [f64; 3], want: [f64; 3]) -> f64 {
-    let w = reference::luminance(want);
-    (reference::luminance(got) - w).abs() / w.max(1e-12)
 }
 
 /// A unit direction spread over the sphere (point `i` of `n` of a Hammersley set through

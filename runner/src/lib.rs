@@ -15,6 +15,7 @@ pub mod error;
 pub mod files;
 pub mod gpu;
 pub mod ktx2;
+pub mod measurement;
 pub mod model;
 pub mod plan;
 pub mod plot;

@@ -19,6 +19,7 @@ use crate::bake::{self, Products, Settings};
 use crate::environment::Environment;
 use crate::error::Result;
 use crate::files;
+use crate::measurement::{ABS, Measurement, REL, arr, rel};
 use crate::plot::{self, Series};
 use crate::texture::Cube;
 use rayon::prelude::*;
@@ -202,56 +203,15 @@ impl Sweep {
     }
 }
 
-/// One measurement.
-#[derive(Clone, Debug)]
-pub struct Measurement {
-    /// Product (and, for the prefilter, its roughness).
-    pub product: String,
-    /// Backend.
-    pub backend: String,
-    /// The knob's value.
-    pub setting: String,
-    /// Wall time in milliseconds (`NaN` where nothing was run).
-    pub time_ms: f64,
-    /// Mean error.
-    pub mean_error: f64,
-    /// Largest error.
-    pub max_error: f64,
-    /// What the errors measure.
-    pub metric: &'static str,
-}
-
-const ABS: &str = "absolute";
-/// The metric of radiance errors.
-pub const REL: &str = "relative luminance";
-
 fn timed<T>(f: impl FnOnce() -> Result<T>) -> Result<(T, f64)> {
     let start = Instant::now();
     let v = f()?;
     Ok((v, start.elapsed().as_secs_f64() * 1e3))
 }
 
-impl Measurement {
-    /// A row from its `errors`: their mean and largest.
-    pub fn of(product: impl Into<String>, backend: impl Into<String>, setting: impl Into<String>, time_ms: f64, errors: &[f64], metric: &'static str) -> Self {
-        let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
-        let max_error = errors.iter().copied().fold(0.0, f64::max);
-        Self { product: product.into(), backend: backend.into(), setting: setting.into(), time_ms, mean_error, max_error, metric }
-    }
-}
-
-fn rel(got: Vec3, want: [f64; 3]) -> f64 {
-    let w = reference::luminance(want);
-    (reference::luminance([got.x as f64, got.y as f64, got.z as f64]) - w).abs() / w.max(1e-12)
-}
-
 /// Unit directions spread over the sphere (a Hammersley set through the equirect map).
 fn directions(n: u32) -> Vec<Vec3> {
     (0..n).map(|i| splitsum_shaders::equirect::uv_to_dir(sampling::hammersley(i, n) * Vec2::new(1.0, 0.96) + Vec2::new(0.0, 0.02))).collect()
-}
-
-fn arr(v: Vec3) -> [f64; 3] {
-    [v.x as f64, v.y as f64, v.z as f64]
 }
 
 /// Runs the report's sweeps of `env` on `backends`, writes the three files into `dir`, and
