@@ -54,6 +54,17 @@ pub enum TableMethod {
     Sampled,
 }
 
+impl TableMethod {
+    /// The masking term a table of this method has unless one is asked for: the exact
+    /// Smith term by quadrature, Smith–Schlick by sampling (the only one it has).
+    pub fn default_masking(self) -> MaskingModel {
+        match self {
+            TableMethod::Quadrature => MaskingModel::Correlated,
+            TableMethod::Sampled => MaskingModel::Schlick,
+        }
+    }
+}
+
 /// The masking–shadowing term the BRDF table is built with (command-line form of
 /// `microfacet::Masking`).
 #[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, serde::Deserialize)]
@@ -204,6 +215,15 @@ impl Settings {
     pub fn roughness(&self) -> Vec<f32> {
         let m: RoughnessMapping = self.mapping.into();
         (0..self.mips).map(|i| m.roughness(i, self.mips)).collect()
+    }
+
+    /// The BRDF table these settings bake, in words: `256² by quadrature (Correlated)` or
+    /// `256² × 1024 samples`.
+    pub fn table_description(&self) -> String {
+        match self.lut_method {
+            TableMethod::Quadrature => format!("{}² by quadrature ({:?})", self.lut_size, self.lut_masking),
+            TableMethod::Sampled => format!("{}² × {} samples", self.lut_size, self.lut_samples),
+        }
     }
 
     /// GGX samples of each specular mip: `samples × sample_growth^(m−1)` from mip 1 on

@@ -343,10 +343,7 @@ impl QualityArgs {
             lut_size: self.lut_size,
             lut_samples: self.lut_samples,
             lut_method: self.lut_method,
-            lut_masking: self.lut_masking.unwrap_or(match self.lut_method {
-                TableMethod::Quadrature => MaskingModel::Correlated,
-                TableMethod::Sampled => MaskingModel::Schlick,
-            }),
+            lut_masking: self.lut_masking.unwrap_or(self.lut_method.default_masking()),
             format: self.format,
         }
     }
@@ -441,10 +438,7 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     }
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();
-    let masking = args.masking.unwrap_or(match args.method {
-        TableMethod::Quadrature => MaskingModel::Correlated,
-        TableMethod::Sampled => MaskingModel::Schlick,
-    });
+    let masking = args.masking.unwrap_or(args.method.default_masking());
     let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: masking, ..Settings::default() };
     if args.samples == 0 {
         anyhow::bail!("--samples must be at least 1");
@@ -455,11 +449,7 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     let lut = bake::brdf_table(&backend, &settings)?;
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
-    let how = match args.method {
-        TableMethod::Quadrature => format!("by quadrature ({masking:?} masking)"),
-        TableMethod::Sampled => format!("at {} samples/texel", args.samples),
-    };
-    println!("brdf lut {}x{} {how} on {}: bake {:.3} s", args.size, args.size, backend.describe(), secs);
+    println!("brdf lut {} on {}: bake {:.3} s", settings.table_description(), backend.describe(), secs);
     println!("wrote {}", args.out.display());
     if let Some(p) = png {
         files::write_png(&p, lut.size, lut.size, &files::lut_preview(&lut))?;
@@ -529,7 +519,7 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
     settings.validate()?;
     let (env, _) = environment::load(&args.env, false)?;
     println!(
-        "bench: {} at size {}, {} mips ({:?}), {:?} samples per mip, irradiance {}² from {}², SH9 from {}², table {}² {}",
+        "bench: {} at size {}, {} mips ({:?}), {:?} samples per mip, irradiance {}² from {}², SH9 from {}², table {}",
         args.env.display(),
         settings.size,
         settings.mips,
@@ -538,11 +528,7 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         settings.irradiance_size,
         settings.irradiance_source,
         settings.sh_source,
-        settings.lut_size,
-        match settings.lut_method {
-            TableMethod::Quadrature => format!("by quadrature ({:?})", settings.lut_masking),
-            TableMethod::Sampled => format!("× {} samples", settings.lut_samples),
-        }
+        settings.table_description()
     );
     for kind in &args.backends {
         let backend = match Backend::open(*kind) {

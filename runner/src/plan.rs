@@ -359,7 +359,7 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     if let Some(n) = q.lut_samples {
         settings.lut_samples = n;
         settings.lut_method = crate::bake::TableMethod::Sampled;
-        settings.lut_masking = crate::bake::MaskingModel::Schlick;
+        settings.lut_masking = settings.lut_method.default_masking();
     } else if let (Some(e), true) = (target, lut) {
         decide("BRDF table method", true, format!("quadrature: max error 1e-5 at every texel ≤ {e}"));
     }
@@ -461,10 +461,7 @@ pub fn describe(plan: &Plan, scene: &str, environment: &str) -> String {
         kept.push(format!("specular {}² × {} mips ({:?}), {} samples, bias {}", s.size, s.mips, s.mapping, s.samples, s.lod_bias));
     }
     if p.lut {
-        kept.push(match s.lut_method {
-            crate::bake::TableMethod::Quadrature => format!("table {}² by quadrature", s.lut_size),
-            crate::bake::TableMethod::Sampled => format!("table {}² × {} samples", s.lut_size, s.lut_samples),
-        });
+        kept.push(format!("table {}", s.table_description()));
     }
     if p.irradiance {
         kept.push(format!("irradiance {}² from {}²", s.irradiance_size, s.irradiance_source));

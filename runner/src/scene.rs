@@ -214,8 +214,7 @@ pub struct MaterialSpec {
 /// The shading options a user chooses beside the models, with their defaults: the
 /// prefiltered cube read along the dominant direction, single scattering, no filtered
 /// sampling, the exact Smith term for direct lights. The one place their flags are made.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::Args)]
-#[serde(default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::Args)]
 pub struct ShadingChoices {
     /// Read the prefiltered cube along the mirror direction (the seed's choice) instead of
     /// the specular dominant direction.
