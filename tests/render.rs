@@ -20,11 +20,9 @@ fn diff(a: &[Vec4], b: &[Vec4]) -> (f32, usize) {
     (worst, over)
 }
 
-/// Every shading model, GPU against CPU, in display values (sRGB-encoded, [0, 1]): the
-/// geometry is ray-cast and every texture read is software filtering in `splitsum_shaders`,
-/// so only float rounding differs.
-#[test]
-fn gpu_matches_the_cpu_reference() {
+/// Renders each of `views` (96×64) on the GPU and with the CPU reference renderer from one
+/// small bake; no pixel may differ by half an 8-bit step. The largest difference.
+fn worst_gpu_vs_cpu(views: impl IntoIterator<Item = ViewState>) -> f32 {
     let env = support::small_display_bake();
     let gpu = match support::gpu() {
         Backend::Gpu(g) => g,
@@ -32,23 +30,35 @@ fn gpu_matches_the_cpu_reference() {
     };
     let scene = GpuScene::new(gpu, &env);
     let mut worst_all = 0.0f32;
+    for view in views {
+        let frame = view.frame(scene.shape, 96, 64, true);
+        let g = scene.render_offscreen(gpu, &frame, None).unwrap();
+        let c = render_cpu(&env, &frame);
+        let (worst, over) = diff(&g, &c);
+        worst_all = worst_all.max(worst);
+        assert_eq!(over, 0, "{}: {over} pixels differ by more than half an 8-bit step (max {worst:e})", view.summary());
+    }
+    worst_all
+}
+
+/// Every shading model, GPU against CPU, in display values (sRGB-encoded, [0, 1]): the
+/// geometry is ray-cast and every texture read is software filtering in `splitsum_shaders`,
+/// so only float rounding differs.
+#[test]
+fn gpu_matches_the_cpu_reference() {
+    let mut views = Vec::new();
     for diffuse in 0..diffuse_model::COUNT {
         for specular in 0..specular_model::COUNT {
             for fresnel in 0..fresnel_model::COUNT {
-                let view = ViewState {
+                views.push(ViewState {
                     options: ShadeOptions { diffuse, specular, fresnel, flags: ShadeOptions::IBL | ShadeOptions::DIRECT },
                     sky_blur: 1.3,
                     ..ViewState::default()
-                };
-                let frame = view.frame(scene.shape, 96, 64, true);
-                let g = scene.render_offscreen(gpu, &frame, None).unwrap();
-                let c = render_cpu(&env, &frame);
-                let (worst, over) = diff(&g, &c);
-                worst_all = worst_all.max(worst);
-                assert_eq!(over, 0, "{}: {over} pixels differ by more than half an 8-bit step (max {worst:e})", view.summary());
+                });
             }
         }
     }
+    let worst_all = worst_gpu_vs_cpu(views);
     println!(
         "scene 96×64, all {} model combinations: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)",
         diffuse_model::COUNT * specular_model::COUNT * fresnel_model::COUNT
@@ -65,24 +75,11 @@ fn gpu_matches_the_cpu_reference() {
 /// together, GPU against CPU, under the same bound as the models.
 #[test]
 fn shading_options_gpu_match_the_cpu_reference() {
-    let env = support::small_display_bake();
-    let gpu = match support::gpu() {
-        Backend::Gpu(g) => g,
-        Backend::Cpu => unreachable!(),
-    };
-    let scene = GpuScene::new(gpu, &env);
     let base = ShadeOptions::IBL | ShadeOptions::DIRECT;
     let all = ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::MULTISCATTER | ShadeOptions::CORRELATED_SMITH | ShadeOptions::FILTERED_SAMPLING;
-    let mut worst_all = 0.0f32;
-    for extra in [0, ShadeOptions::DOMINANT_DIRECTION, ShadeOptions::MULTISCATTER, ShadeOptions::CORRELATED_SMITH, ShadeOptions::FILTERED_SAMPLING, all] {
-        let view = ViewState { options: ShadeOptions { flags: base | extra, ..ShadeOptions::DEFAULT }, ..ViewState::default() };
-        let frame = view.frame(scene.shape, 96, 64, true);
-        let g = scene.render_offscreen(gpu, &frame, None).unwrap();
-        let c = render_cpu(&env, &frame);
-        let (worst, over) = diff(&g, &c);
-        worst_all = worst_all.max(worst);
-        assert_eq!(over, 0, "flags {extra:#x}: {over} pixels differ by more than half an 8-bit step (max {worst:e})");
-    }
+    let extras = [0, ShadeOptions::DOMINANT_DIRECTION, ShadeOptions::MULTISCATTER, ShadeOptions::CORRELATED_SMITH, ShadeOptions::FILTERED_SAMPLING, all];
+    let worst_all =
+        worst_gpu_vs_cpu(extras.map(|extra| ViewState { options: ShadeOptions { flags: base | extra, ..ShadeOptions::DEFAULT }, ..ViewState::default() }));
     println!("scene 96×64, shading options: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)");
     let bound = support::gpu_bound(1e-5, 2e-4) as f32;
     assert!(worst_all < bound, "{worst_all:e} (bound {bound:e})");
