@@ -25,7 +25,7 @@
 //!   (Smith–Schlick against exact Smith).
 
 use crate::backend::Backend;
-use crate::bake::{self, MaskingModel, Products, Settings};
+use crate::bake::{self, MaskingModel, Settings};
 use crate::environment::Environment;
 use crate::error::Result;
 use crate::measurement::{Measurement, REL, arr, rel, rel64};
@@ -33,8 +33,7 @@ use crate::texture::Cube;
 use rayon::prelude::*;
 use splitsum_reference as reference;
 use splitsum_shaders::glam::{Vec2, Vec3};
-use splitsum_shaders::prefilter::RoughnessMapping;
-use splitsum_shaders::shade::{self, EnvironmentShape, IblSample, Material, ShadeOptions};
+use splitsum_shaders::shade::{self, IblSample, Material, ShadeOptions};
 use splitsum_shaders::{equirect, sampling};
 use std::time::Instant;
 
@@ -106,8 +105,6 @@ struct LookupPoint {
 pub struct Points {
     shading: Vec<ShadingPoint>,
     lookups: Vec<LookupPoint>,
-    /// Face size of the source cube the references integrate.
-    pub source_size: u32,
 }
 
 fn vec(c: [f64; 3]) -> Vec3 {
@@ -222,7 +219,7 @@ impl Points {
             .into_par_iter()
             .map(|(dir, roughness, near_sun)| LookupPoint { dir, roughness, near_sun, exact: env.prefilter(arr(dir), roughness as f64) })
             .collect();
-        Self { shading, lookups, source_size: s }
+        Self { shading, lookups }
     }
 }
 
@@ -251,23 +248,11 @@ pub fn seed_settings(source_size: u32) -> Settings {
 pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points: &Points) -> Result<Vec<Measurement>> {
     let b = backend.describe();
     let mut rows = Vec::new();
-    let products = Products { specular: true, irradiance: true, sh9: false, lut: true };
     for method in methods {
         let start = Instant::now();
-        let baked = bake::bake(backend, env, &method.settings, products)?;
+        let baked = bake::bake_for_display(backend, env, &method.settings)?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        let (spec, irr, table) = (baked.specular.expect("baked"), baked.irradiance.expect("baked"), baked.lut.expect("baked"));
-        let mapping = RoughnessMapping::from(method.settings.mapping);
-        let shape = EnvironmentShape {
-            specular_size: spec.layout.size,
-            specular_levels: spec.layout.levels,
-            mapping: mapping as u32,
-            irradiance_size: irr.layout.size,
-            lut_size: table.size,
-            source_size: 1,
-            source_levels: 1,
-            pad: 0,
-        };
+        let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
         let opts = method.options();
         let dominant = usize::from(opts.flags & ShadeOptions::DOMINANT_DIRECTION != 0);
         let correlated = usize::from(method.settings.lut_masking == MaskingModel::Correlated);

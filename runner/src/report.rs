@@ -15,7 +15,7 @@
 //! per product and backend).
 
 use crate::backend::Backend;
-use crate::bake::{self, Products, Settings};
+use crate::bake::{self, Settings};
 use crate::environment::Environment;
 use crate::error::Result;
 use crate::files;
@@ -28,7 +28,7 @@ use splitsum_shaders::cubemap::{self, CubeLayout};
 use splitsum_shaders::glam::{Vec2, Vec3};
 use splitsum_shaders::irradiance::sh9_irradiance;
 use splitsum_shaders::prefilter::RoughnessMapping;
-use splitsum_shaders::shade::{self, EnvironmentShape, Material, ShadeOptions};
+use splitsum_shaders::shade::{self, Material, ShadeOptions};
 use splitsum_shaders::{lut, sampling};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -426,20 +426,9 @@ fn irradiance_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References,
 
 fn shaded_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, env: &Environment) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
-    let products = Products { specular: true, irradiance: true, sh9: false, lut: true };
     for (label, settings) in &sweep.qualities {
-        let (baked, ms) = timed(|| bake::bake(backend, env, settings, products))?;
-        let (spec, irr, table) = (baked.specular.expect("baked"), baked.irradiance.expect("baked"), baked.lut.expect("baked"));
-        let shape = EnvironmentShape {
-            specular_size: spec.layout.size,
-            specular_levels: spec.layout.levels,
-            mapping: RoughnessMapping::from(settings.mapping) as u32,
-            irradiance_size: irr.layout.size,
-            lut_size: table.size,
-            source_size: 1,
-            source_levels: 1,
-            pad: 0,
-        };
+        let (baked, ms) = timed(|| bake::bake_for_display(backend, env, settings))?;
+        let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
         for &(view, lo, hi) in &VIEWS {
             let errors: Vec<f64> = refs
                 .shading
