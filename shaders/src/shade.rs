@@ -99,7 +99,8 @@ impl ShadeOptions {
     /// mirror direction ([`dominant_direction`]).
     pub const DOMINANT_DIRECTION: u32 = 4;
     /// Multiple-scattering energy compensation of the image-based specular
-    /// ([`multiple_scattering`]).
+    /// ([`multiple_scattering`]), for Cook–Torrance with Lambert or Oren–Nayar diffuse (the
+    /// Fresnel-weighted diffuse carries its own energy split and is left as it is).
     pub const MULTISCATTER: u32 = 8;
     /// Direct lights with the exact height-correlated Smith visibility instead of
     /// Smith–Schlick (image-based light follows the table's own model).
