@@ -84,7 +84,33 @@ fn check_lut_args(size: u32, samples: u32) -> Result<()> {
     Ok(())
 }
 
+/// Bytes of `texels` RGBA f32 texels.
+fn bytes(texels: u64) -> u64 {
+    texels * 16
+}
+
 impl Backend {
+    /// The GPU, if this is the GPU backend and each of `buffers` (bytes) fits in one storage
+    /// binding of the device; otherwise `None`, and where the GPU is too small for them, a
+    /// note on stderr that `step` runs on the CPU instead (the same shared functions, so
+    /// the results agree within the GPU-vs-CPU bounds).
+    fn gpu_for(&self, step: &str, buffers: &[u64]) -> Option<&Gpu> {
+        let Backend::Gpu(g) = self else { return None };
+        let max = g.max_binding();
+        match buffers.iter().copied().max() {
+            Some(need) if need > max => {
+                eprintln!(
+                    "note: {step} needs a {:.0} MiB buffer, more than {} binds ({:.0} MiB): running this step on the CPU",
+                    need as f64 / 1048576.0,
+                    g.info.name,
+                    max as f64 / 1048576.0
+                );
+                None
+            }
+            _ => Some(g),
+        }
+    }
+
     /// Opens `kind` (for the GPU: adapter, device and pipelines, outside any timing).
     pub fn open(kind: BackendKind) -> Result<Self> {
         Ok(match kind {
@@ -101,14 +127,20 @@ impl Backend {
         }
     }
 
+    /// What the backend's results depend on, for cache keys: the adapter and driver, or
+    /// `cpu` (results on the CPU do not depend on the number of threads).
+    pub fn identity(&self) -> String {
+        match self {
+            Backend::Gpu(g) => format!("gpu: {}", g.describe()),
+            Backend::Cpu => "cpu".into(),
+        }
+    }
+
     /// The `size`×`size` BRDF table from `samples` points per texel.
     pub fn brdf_lut(&self, size: u32, samples: u32) -> Result<Lut> {
         check_lut_args(size, samples)?;
-        let g = match self {
-            Backend::Cpu => return Ok(cpu::brdf_lut(size, samples)),
-            Backend::Gpu(g) => g,
-        };
         let n = size as u64 * size as u64;
+        let Some(g) = self.gpu_for("the BRDF table", &[bytes(n)]) else { return Ok(cpu::brdf_lut(size, samples)) };
         let accum = g.output("brdf lut sums", n * 16)?;
         for (start, count) in chunks(samples) {
             table_rows(g, Kernel::BrdfLut, size, count, &accum, |row_offset| LutParams { size, samples, row_offset, start, count, pad0: 0, pad1: 0, pad2: 0 });
@@ -121,11 +153,8 @@ impl Backend {
     /// (`lut::integrate_brdf_quadrature`).
     pub fn brdf_table(&self, size: u32, masking: Masking) -> Result<Lut> {
         check_lut_args(size, 1)?;
-        let g = match self {
-            Backend::Cpu => return Ok(cpu::brdf_table(size, masking)),
-            Backend::Gpu(g) => g,
-        };
         let n = size as u64 * size as u64;
+        let Some(g) = self.gpu_for("the BRDF table", &[bytes(n)]) else { return Ok(cpu::brdf_table(size, masking)) };
         let out = g.output("brdf table", n * 16)?;
         let per_texel = splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS;
         table_rows(g, Kernel::BrdfTable, size, per_texel, &out, |row_offset| TableParams { size, masking: masking as u32, row_offset, pad: 0 });
@@ -136,16 +165,14 @@ impl Backend {
     /// The source cube: `env` resampled to faces of `size` with `supersample`² points per
     /// texel, and its full mip chain.
     pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Cube> {
-        let g = match self {
-            Backend::Cpu => {
-                let mut cube = cpu::equirect_to_cube(env, size, supersample);
-                cpu::build_mips(&mut cube);
-                return Ok(cube);
-            }
-            Backend::Gpu(g) => g,
-        };
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
         let (w, h) = (env.width, env.height);
+        let pyramid_bytes = bytes(equirect::pyramid_len(w, h) as u64);
+        let Some(g) = self.gpu_for(&format!("resampling the {w}×{h} equirect (its row pyramid)"), &[pyramid_bytes, bytes(layout.texel_count() as u64)]) else {
+            let mut cube = cpu::equirect_to_cube(env, size, supersample);
+            self.build_mips(&mut cube)?;
+            return Ok(cube);
+        };
         let levels = equirect::pyramid_levels(w);
         let mut texels = env.texels.clone();
         texels.resize(equirect::pyramid_len(w, h) as usize, Vec4::ZERO);
@@ -178,9 +205,10 @@ impl Backend {
 
     /// Fills levels 1.. of `cube` from its level 0.
     pub fn build_mips(&self, cube: &mut Cube) -> Result<()> {
-        match self {
-            Backend::Cpu => cpu::build_mips(cube),
-            Backend::Gpu(g) => {
+        let s = cube.layout.size;
+        match self.gpu_for(&format!("the mips of the {s}² cube"), &[bytes(cube.texels.len() as u64)]) {
+            None => cpu::build_mips(cube),
+            Some(g) => {
                 let buf = g.upload("cube", bytemuck::cast_slice(&cube.texels));
                 self.gpu_mips(g, &buf, cube.layout);
                 cube.texels = read_vec4(g, &buf, cube.layout.texel_count())?;
@@ -229,9 +257,9 @@ impl Backend {
         }
         let exact_levels: Vec<u32> =
             roughness.iter().zip(samples).map(|(&r, &n)| if exact { prefilter::exact_level(r, n, src.layout) } else { prefilter::SAMPLED }).collect();
-        let g = match self {
-            Backend::Cpu => return Ok(cpu::prefilter(src, out, roughness, levels, samples, &exact_levels, lod_bias)),
-            Backend::Gpu(g) => g,
+        let buffers = [bytes(src.texels.len() as u64), 3 * bytes(out.texel_count() as u64)];
+        let Some(g) = self.gpu_for(&format!("prefiltering from the {}² source cube", src.layout.size), &buffers) else {
+            return Ok(cpu::prefilter(src, out, roughness, levels, samples, &exact_levels, lod_bias));
         };
         let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
         let accum = g.output("specular sums", out.texel_count() as u64 * 48)?;
@@ -295,11 +323,11 @@ impl Backend {
 
     /// The irradiance cube (`E/π`) of face size `size` from level `level` of `src`.
     pub fn irradiance(&self, src: &Cube, level: u32, size: u32) -> Result<Cube> {
-        let g = match self {
-            Backend::Cpu => return Ok(cpu::irradiance(src, level, size)),
-            Backend::Gpu(g) => g,
-        };
         let layout = CubeLayout::new(size, 1);
+        let buffers = [bytes(src.texels.len() as u64), 3 * bytes(layout.texel_count() as u64)];
+        let Some(g) = self.gpu_for(&format!("the irradiance from the {}² source cube", src.layout.size), &buffers) else {
+            return Ok(cpu::irradiance(src, level, size));
+        };
         let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
         let accum = g.output("irradiance sums", layout.texel_count() as u64 * 48)?;
         let s = src.layout.level_size(level);
@@ -316,9 +344,9 @@ impl Backend {
 
     /// The nine SH coefficients of radiance of level `level` of `src`.
     pub fn sh9(&self, src: &Cube, level: u32) -> Result<Sh9> {
-        let rows = match self {
-            Backend::Cpu => cpu::sh9_rows(src, level),
-            Backend::Gpu(g) => {
+        let rows = match self.gpu_for(&format!("SH9 from the {}² source cube", src.layout.size), &[bytes(src.texels.len() as u64)]) {
+            None => cpu::sh9_rows(src, level),
+            Some(g) => {
                 let s = src.layout.level_size(level);
                 let input = g.upload("source cube", bytemuck::cast_slice(&src.texels));
                 let n = FACES * s * (SH9 as u32 + 1);
@@ -364,8 +392,8 @@ impl Backend {
             probe_mode::IRRADIANCE => FACES * layout.level_size(p.src_level).pow(2),
             _ => 1,
         };
-        let raw = match self {
-            Backend::Cpu => {
+        let raw = match self.gpu_for("the probes", &[bytes((texels.len() + probes.len()) as u64), 3 * bytes(probes.len() as u64)]) {
+            None => {
                 let mut out = vec![Vec4::ZERO; 3 * probes.len()];
                 for (i, &q) in probes.iter().enumerate() {
                     for (start, chunk) in chunks(terms) {
@@ -374,7 +402,7 @@ impl Backend {
                 }
                 out
             }
-            Backend::Gpu(g) => {
+            Some(g) => {
                 let mut input = texels.to_vec();
                 input.extend_from_slice(probes);
                 let buf = g.upload("probes", bytemuck::cast_slice(&input));

@@ -636,10 +636,10 @@ pub fn bake_scene(
         Some(p) => crate::environment::load(p, scene.sanitize)?,
         None => (crate::environment::embedded_default()?, Default::default()),
     };
-    let identity = crate::environment::identity_bytes(env_path.as_deref())?;
+    let identity = crate::environment::identity(env_path.as_deref())?;
     let plan = crate::plan::plan_for(scene, &env, cal);
     let plan_json = serde_json::to_string(&(&plan.settings, &plan.products, &plan.levels, scene.sanitize)).expect("serialisable");
-    let key = crate::cache::key(&identity, &plan_json, &backend.describe());
+    let key = crate::cache::key(&identity, &plan_json, &backend.identity());
     let mut outcome = if force { Outcome::Forced } else { Outcome::Baked };
     if let (Some(c), false) = (cache, force) {
         match c.get(&key) {

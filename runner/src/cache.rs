@@ -20,7 +20,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Version of the entry format (part of every key).
-pub const FORMAT: &str = "splitsum-cache-1";
+pub const FORMAT: &str = "splitsum-cache-2";
 
 /// The cache folder: `$SPLITSUM_CACHE`, else `$XDG_CACHE_HOME/splitsum`, else
 /// `~/.cache/splitsum`, else `.splitsum-cache`.
@@ -37,8 +37,8 @@ pub fn default_dir() -> PathBuf {
     PathBuf::from(".splitsum-cache")
 }
 
-/// The key of a bake: BLAKE3 of the format, the environment's bytes, the plan (as JSON),
-/// the backend and the SPIR-V module.
+/// The key of a bake: BLAKE3 of the format, the environment's identity (the hash of its
+/// bytes, `environment::identity`), the plan (as JSON), the backend and the SPIR-V module.
 pub fn key(environment: &[u8], plan_json: &str, backend: &str) -> String {
     let mut h = blake3::Hasher::new();
     for part in [FORMAT.as_bytes(), environment, plan_json.as_bytes(), backend.as_bytes(), crate::gpu::SPIRV] {

@@ -476,16 +476,7 @@ fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
     settings.validate()?;
     std::fs::create_dir_all(&args.out).map_err(|e| crate::Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
     files::check_writable(&args.out.join("bake.json"))?;
-    let (env, input) = environment::load(&env_path, args.sanitize)?;
-    if input.negative > 0 {
-        eprintln!("note: {}: {} texels had negative values, set to 0", env_path.display(), input.negative);
-    }
-    if input.clamped > 0 {
-        eprintln!("note: {}: {} texels were brighter than 1e20 and were clamped to it", env_path.display(), input.clamped);
-    }
-    if input.sanitized && (input.nan > 0 || input.infinite > 0) {
-        eprintln!("note: {}: replaced {} NaN and {} infinite texels (--sanitize)", env_path.display(), input.nan, input.infinite);
-    }
+    let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
     let backend = Backend::open(args.backend)?;
     println!("baking {} on {}", env_path.display(), backend.describe());
     let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
@@ -517,7 +508,7 @@ fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
 fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let settings = args.quality.settings();
     settings.validate()?;
-    let (env, _) = environment::load(&args.env, false)?;
+    let (env, _) = load_input(&args.env, false, settings.source_size)?;
     println!(
         "bench: {} at size {}, {} mips ({:?}), {:?} samples per mip, irradiance {}² from {}², SH9 from {}², table {}",
         args.env.display(),
@@ -558,16 +549,38 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The environment at `path`, or the embedded default.
+/// Reads the environment at `path` for cubes of faces up to `face`
+/// (`environment::load_for`), saying on stderr what reading it changed.
+pub fn load_input(path: &std::path::Path, sanitize: bool, face: u32) -> anyhow::Result<(environment::Environment, environment::InputReport)> {
+    let (env, input) = environment::load_for(path, sanitize, face)?;
+    let p = path.display();
+    if input.negative > 0 {
+        eprintln!("note: {p}: {} texels had negative values, set to 0", input.negative);
+    }
+    if input.clamped > 0 {
+        eprintln!("note: {p}: {} texels were brighter than 1e20 and were clamped to it", input.clamped);
+    }
+    if input.sanitized && (input.nan > 0 || input.infinite > 0) {
+        eprintln!("note: {p}: replaced {} NaN and {} infinite texels (--sanitize)", input.nan, input.infinite);
+    }
+    let (w, h) = input.original;
+    match &env {
+        environment::Environment::Equirect(e) if e.width < w => {
+            eprintln!("note: {p}: {w}×{h} read as {}×{} (area-weighted): a cube of {face}² faces resolves no more (--source-size)", e.width, e.height)
+        }
+        environment::Environment::Cube(c) if c.layout.size < w => {
+            eprintln!("note: {p}: faces of {w}² read as {}² (the cube's own mip filter): the bake uses no more (--source-size)", c.layout.size)
+        }
+        _ => {}
+    }
+    Ok((env, input))
+}
+
+/// The environment at `path` (for the display and the planner: cubes up to
+/// `environment::NATIVE_FACE`), or the embedded default.
 pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyhow::Result<(environment::Environment, String)> {
     match path {
-        Some(p) => {
-            let (env, input) = environment::load(p, sanitize)?;
-            if input.negative > 0 {
-                eprintln!("note: {}: {} texels had negative values, set to 0", p.display(), input.negative);
-            }
-            Ok((env, p.display().to_string()))
-        }
+        Some(p) => Ok((load_input(p, sanitize, environment::NATIVE_FACE)?.0, p.display().to_string())),
         None => Ok((environment::embedded_default()?, "the embedded courtyard (CC0)".to_string())),
     }
 }

@@ -11,7 +11,8 @@
 
 use crate::error::{Error, Result};
 use crate::texture::{Cube, Equirect};
-use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::cubemap::{self, CubeLayout};
+use splitsum_shaders::equirect;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::math::MAX_RADIANCE;
 use std::path::{Path, PathBuf};
@@ -45,22 +46,48 @@ pub struct InputReport {
     pub sanitized: bool,
     /// The largest finite value of any channel.
     pub max_value: f32,
+    /// Width and height of the file (of one face, for a cube), before any reduction.
+    pub original: (u32, u32),
+}
+
+impl InputReport {
+    fn add(&mut self, r: &InputReport) {
+        self.negative += r.negative;
+        self.clamped += r.clamped;
+        self.nan += r.nan;
+        self.infinite += r.infinite;
+        self.max_value = self.max_value.max(r.max_value);
+    }
 }
 
 /// Face file names of a cube map folder, in KTX2/Vulkan face order.
 pub const FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
 
-/// Reads an environment: a `.hdr`/`.exr` equirect file, or a folder holding six faces
-/// `px nx py ny pz nz` (`.hdr` or `.exr`) in Vulkan/KTX2 orientation.
+/// The largest cube face the display and the planner build from an environment (see
+/// `plan::native_face_size`): what [`load`] reads an environment for.
+pub const NATIVE_FACE: u32 = 1024;
+
+/// Reads an environment for cubes of faces up to [`NATIVE_FACE`] (see [`load_for`]).
 pub fn load(path: &Path, sanitize: bool) -> Result<(Environment, InputReport)> {
+    load_for(path, sanitize, NATIVE_FACE)
+}
+
+/// Reads an environment: a `.hdr`/`.exr` equirect file, or a folder holding six faces
+/// `px nx py ny pz nz` (`.hdr` or `.exr`) in Vulkan/KTX2 orientation, keeping only the
+/// resolution a cube of faces `face` wide resolves: an equirect is reduced by
+/// `equirect::reduction_factor` (area-weighted, as it is decoded, so a 16384×8192 file is
+/// never held whole), and faces wider than `face` are reduced to `face` through the cube's
+/// own mip filter. [`InputReport::original`] keeps the size of the file.
+pub fn load_for(path: &Path, sanitize: bool, face: u32) -> Result<(Environment, InputReport)> {
     if path.is_dir() {
         let faces = face_paths(path)?;
-        return load_faces(&faces, sanitize);
+        return load_faces(&faces, sanitize, face);
     }
-    let (width, height, mut texels) = read_image(path)?;
+    let (width, height) = dimensions(path)?;
     check_equirect_shape(path, width, height)?;
-    let report = clean(path, &mut texels, sanitize)?;
-    Ok((Environment::Equirect(Equirect { width, height, texels }), report))
+    let factor = equirect::reduction_factor(width, height, face);
+    let (image, report) = read_reduced(path, sanitize, factor)?;
+    Ok((Environment::Equirect(image), report))
 }
 
 /// The six face files of a cube map folder.
@@ -77,13 +104,16 @@ pub fn face_paths(dir: &Path) -> Result<[PathBuf; 6]> {
     Ok([find("px")?, find("nx")?, find("py")?, find("ny")?, find("pz")?, find("nz")?])
 }
 
-/// Reads six square, equally sized, power-of-two faces into a one-level cube.
-pub fn load_faces(paths: &[PathBuf; 6], sanitize: bool) -> Result<(Environment, InputReport)> {
+/// Reads six square, equally sized, power-of-two faces into a one-level cube, each reduced
+/// to `face` wide (if wider) by the cube's solid-angle-weighted 2×2 filter
+/// (`cubemap::downsample_texel`, the same arithmetic as the source cube's mips), one face
+/// at a time.
+pub fn load_faces(paths: &[PathBuf; 6], sanitize: bool, face: u32) -> Result<(Environment, InputReport)> {
     let mut size = 0;
     let mut all = Vec::new();
     let mut report = InputReport { sanitized: sanitize, ..Default::default() };
     for p in paths {
-        let (w, h, mut t) = read_image(p)?;
+        let (w, h) = dimensions(p)?;
         if w != h {
             return Err(Error::file(p, format!("a cube face must be square, this one is {w}×{h}")));
         }
@@ -95,14 +125,20 @@ pub fn load_faces(paths: &[PathBuf; 6], sanitize: bool) -> Result<(Environment, 
         } else if w != size {
             return Err(Error::file(p, format!("is {w}×{w} but the first face is {size}×{size}")));
         }
-        let r = clean(p, &mut t, sanitize)?;
-        report.negative += r.negative;
-        report.clamped += r.clamped;
-        report.nan += r.nan;
-        report.infinite += r.infinite;
-        report.max_value = report.max_value.max(r.max_value);
-        all.extend(t);
+        let (img, r) = read_reduced(p, sanitize, 1)?;
+        report.add(&r);
+        let mut texels = img.texels;
+        let mut s = w;
+        while s > face.max(1) {
+            let layout = CubeLayout::new(s, 1);
+            let h = s / 2;
+            texels = (0..h * h).map(|i| cubemap::downsample_texel(&texels, layout, 0, 0, i % h, i / h)).collect();
+            s = h;
+        }
+        all.extend(texels);
     }
+    report.original = (size, size);
+    let size = size.min(face.max(1));
     Ok((Environment::Cube(Cube { layout: CubeLayout::new(size, 1), texels: all }), report))
 }
 
@@ -119,29 +155,71 @@ fn check_equirect_shape(path: &Path, width: u32, height: u32) -> Result<()> {
     Ok(())
 }
 
-/// Reads an `.hdr` or `.exr` image as RGBA f32 (alpha 1), row 0 at the top.
-pub fn read_image(path: &Path) -> Result<(u32, u32, Vec<Vec4>)> {
-    let bytes = std::fs::read(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    if bytes.starts_with(&[0x76, 0x2f, 0x31, 0x01]) {
-        read_exr(path, &bytes)
-    } else if bytes.starts_with(b"#?") {
-        read_hdr(path, &bytes)
-    } else if bytes.is_empty() {
-        Err(Error::file(path, "is empty"))
-    } else {
-        Err(Error::file(path, "is neither an OpenEXR nor a Radiance HDR file (unknown signature)"))
+/// What kind of image a file holds, by its signature.
+enum Kind {
+    Exr,
+    Hdr,
+}
+
+fn kind(path: &Path) -> Result<Kind> {
+    use std::io::Read;
+    let mut head = [0u8; 4];
+    let mut f = std::fs::File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let n = f.read(&mut head).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    match &head[..n] {
+        [0x76, 0x2f, 0x31, 0x01] => Ok(Kind::Exr),
+        [b'#', b'?', ..] => Ok(Kind::Hdr),
+        [] => Err(Error::file(path, "is empty")),
+        _ => Err(Error::file(path, "is neither an OpenEXR nor a Radiance HDR file (unknown signature)")),
     }
 }
 
-fn read_hdr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Vec4>)> {
+/// Width and height of an `.hdr` or `.exr` image, from its header alone.
+pub fn dimensions(path: &Path) -> Result<(u32, u32)> {
+    let (w, h) = match kind(path)? {
+        Kind::Exr => {
+            let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| Error::file(path, format!("truncated or malformed OpenEXR: {e}")))?;
+            let header = meta.headers.first().ok_or_else(|| Error::file(path, "malformed OpenEXR: no header"))?;
+            let size = header.layer_size;
+            (size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32)
+        }
+        Kind::Hdr => {
+            use image::ImageDecoder;
+            let decoder = image::codecs::hdr::HdrDecoder::new(buffered(path)?).map_err(|e| Error::file(path, format!("malformed Radiance HDR: {e}")))?;
+            decoder.dimensions()
+        }
+    };
+    check_side(path, w, h)?;
+    Ok((w, h))
+}
+
+fn buffered(path: &Path) -> Result<std::io::BufReader<std::fs::File>> {
+    Ok(std::io::BufReader::new(std::fs::File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?))
+}
+
+/// Reads an `.hdr` or `.exr` image as RGBA f32 (alpha 1), row 0 at the top, reduced by
+/// `factor` as an equirect ([`Reducer`]) and cleaned ([`clean`]'s rules).
+pub fn read_reduced(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
+    match kind(path)? {
+        Kind::Exr => read_exr(path, buffered(path)?, sanitize, factor),
+        Kind::Hdr => read_hdr(path, sanitize, factor),
+    }
+}
+
+fn read_hdr(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
     use image::ImageDecoder;
-    let decoder = image::codecs::hdr::HdrDecoder::new(std::io::Cursor::new(bytes)).map_err(|e| Error::file(path, format!("malformed Radiance HDR: {e}")))?;
+    let decoder = image::codecs::hdr::HdrDecoder::new(buffered(path)?).map_err(|e| Error::file(path, format!("malformed Radiance HDR: {e}")))?;
     let (w, h) = decoder.dimensions();
     check_side(path, w, h)?;
+    let mut reducer = Reducer::new(w, h, factor, sanitize);
     let mut buf = vec![0u8; decoder.total_bytes() as usize];
     decoder.read_image(&mut buf).map_err(|e| Error::file(path, format!("truncated or malformed Radiance HDR: {e}")))?;
-    let rgb: Vec<f32> = bytemuck::pod_collect_to_vec(&buf);
-    Ok((w, h, rgb.chunks_exact(3).map(|c| Vec4::new(c[0], c[1], c[2], 1.0)).collect()))
+    for (i, c) in buf.chunks_exact(12).enumerate() {
+        let v: [f32; 3] = bytemuck::pod_read_unaligned(c);
+        reducer.push(i as u32 % w, i as u32 / w, v);
+    }
+    drop(buf);
+    reducer.finish(path)
 }
 
 fn check_side(path: &Path, w: u32, h: u32) -> Result<()> {
@@ -154,7 +232,53 @@ fn check_side(path: &Path, w: u32, h: u32) -> Result<()> {
     Ok(())
 }
 
-fn read_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Vec4>)> {
+/// An OpenEXR file's R, G, B channels, streamed block by block into a [`Reducer`]; files
+/// without plain `R`, `G`, `B` channels (luminance `Y`, or layer-prefixed names) are read
+/// whole ([`read_exr_channels`]).
+fn read_exr(path: &Path, reader: impl std::io::Read + std::io::Seek, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
+    use exr::prelude::{ReadChannels, ReadLayers, ReadSpecificChannel};
+    let streamed = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .specific_channels()
+        .required("R")
+        .required("G")
+        .required("B")
+        .collect_pixels(
+            |size: exr::math::Vec2<usize>, _: &_| {
+                let (w, h) = (size.width() as u32, size.height() as u32);
+                (w > 0 && h > 0 && w <= MAX_SIDE && h <= MAX_SIDE).then(|| Reducer::new(w, h, factor, sanitize))
+            },
+            |r: &mut Option<Reducer>, pos: exr::math::Vec2<usize>, (red, green, blue): (f32, f32, f32)| {
+                if let Some(r) = r {
+                    r.push(pos.x() as u32, pos.y() as u32, [red, green, blue]);
+                }
+            },
+        )
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(reader);
+    match streamed {
+        Ok(image) => match image.layer_data.channel_data.pixels {
+            Some(reducer) => reducer.finish(path),
+            None => {
+                let size = image.layer_data.size;
+                check_side(path, size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32)?;
+                Err(Error::file(path, "malformed OpenEXR: no pixels"))
+            }
+        },
+        Err(exr::error::Error::Invalid(_)) | Err(exr::error::Error::NotSupported(_)) => read_exr_channels(path, sanitize, factor),
+        Err(e) => Err(Error::file(path, format!("truncated or malformed OpenEXR: {e}"))),
+    }
+}
+
+/// An OpenEXR file read whole, every channel, then R, G, B (matched by the last part of
+/// their names) or Y.
+fn read_exr_channels(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
+    exr_channels(path, buffered(path)?, sanitize, factor)
+}
+
+fn exr_channels(path: &Path, reader: impl std::io::Read + std::io::Seek, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
     use exr::prelude::{AnyChannel, FlatSamples, ReadChannels, ReadLayers};
     let image = exr::prelude::read()
         .no_deep_data()
@@ -162,11 +286,11 @@ fn read_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Vec4>)> {
         .all_channels()
         .first_valid_layer()
         .all_attributes()
-        .from_buffered(std::io::Cursor::new(bytes))
+        .from_buffered(reader)
         .map_err(|e| Error::file(path, format!("truncated or malformed OpenEXR: {e}")))?;
     let layer = &image.layer_data;
     let size = layer.size;
-    let (w, h) = (size.width() as u32, size.height() as u32);
+    let (w, h) = (size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32);
     check_side(path, w, h)?;
     let channel = |names: &[&str]| {
         layer.channel_data.list.iter().find(|c| {
@@ -175,63 +299,111 @@ fn read_exr(path: &Path, bytes: &[u8]) -> Result<(u32, u32, Vec<Vec4>)> {
             names.iter().any(|x| base.eq_ignore_ascii_case(x))
         })
     };
-    let n = (w * h) as usize;
-    let values = |c: &AnyChannel<FlatSamples>| -> Vec<f32> { c.sample_data.values_as_f32().collect() };
+    let n = (w as usize) * (h as usize);
+    let at = |c: &AnyChannel<FlatSamples>, i: usize| -> f32 { c.sample_data.value_by_flat_index(i).to_f32() };
     let (r, g, b) = match (channel(&["R", "red"]), channel(&["G", "green"]), channel(&["B", "blue"])) {
-        (Some(r), Some(g), Some(b)) => (values(r), values(g), values(b)),
+        (Some(r), Some(g), Some(b)) => (r, g, b),
         _ => match channel(&["Y", "L"]) {
-            Some(y) => {
-                let y = values(y);
-                (y.clone(), y.clone(), y)
-            }
+            Some(y) => (y, y, y),
             None => {
                 let names: Vec<String> = layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
                 return Err(Error::file(path, format!("has no R, G, B (or Y) channels, only {names:?}")));
             }
         },
     };
-    if r.len() != n || g.len() != n || b.len() != n {
+    if [r, g, b].iter().any(|c| c.sample_data.len() != n) {
         return Err(Error::file(path, "channels are subsampled, which is not supported"));
     }
-    Ok((w, h, (0..n).map(|i| Vec4::new(r[i], g[i], b[i], 1.0)).collect()))
+    let mut reducer = Reducer::new(w, h, factor, sanitize);
+    for i in 0..n {
+        reducer.push((i % w as usize) as u32, (i / w as usize) as u32, [at(r, i), at(g, i), at(b, i)]);
+    }
+    reducer.finish(path)
 }
 
 /// Counts and fixes negative values, and refuses or sanitises NaN and ∞ (see the module
-/// documentation). Alpha is set to 1.
+/// documentation), in place. Alpha is set to 1.
 pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputReport> {
-    let mut report = InputReport { sanitized: sanitize, ..Default::default() };
-    let mut channel_max = [0.0f32; 3];
-    for t in texels.iter() {
-        let c = [t.x, t.y, t.z];
-        if c.iter().any(|v| v.is_nan()) {
-            report.nan += 1;
-        } else if c.iter().any(|v| v.is_infinite()) {
-            report.infinite += 1;
+    let mut reducer = Reducer::new(texels.len() as u32, 1, 1, sanitize);
+    for (i, t) in texels.iter().enumerate() {
+        reducer.push(i as u32, 0, [t.x, t.y, t.z]);
+    }
+    let (image, report) = reducer.finish(path)?;
+    texels.copy_from_slice(&image.texels);
+    Ok(report)
+}
+
+/// An equirect image received pixel by pixel, in any order (an EXR's blocks may arrive
+/// out of order), cleaned as it comes (the module documentation's rules) and reduced by
+/// `factor` in both axes: each output texel is the solid-angle-weighted mean
+/// (`equirect::row_solid_angle`) of the `factor²` input texels it covers, summed in f64.
+/// Only the output rows still being filled hold f64 sums, so memory is the output image
+/// plus a few rows, whatever the input's size. A `height` of 1 weighs every texel alike
+/// (a plain list of texels, or a cube face at factor 1).
+struct Reducer {
+    width: u32,
+    height: u32,
+    factor: u32,
+    sanitize: bool,
+    out: Vec<Vec4>,
+    /// f64 sums (r, g, b) of the output rows being filled.
+    pending: Vec<Option<Box<[f64]>>>,
+    /// Input texels received per output row.
+    arrived: Vec<u32>,
+    /// Solid angle of each input row.
+    row_weight: Vec<f64>,
+    /// (output texel, channels that are +∞ (bit k), weight, already counted as clamped) of
+    /// each input with a +∞ channel: replaced by the channel's largest finite value when the
+    /// image is complete (and counted as clamped if that value is).
+    infinite: Vec<(u32, u8, f64, bool)>,
+    channel_max: [f32; 3],
+    report: InputReport,
+}
+
+impl Reducer {
+    fn new(width: u32, height: u32, factor: u32, sanitize: bool) -> Self {
+        let factor = if width % factor == 0 && height % factor == 0 { factor.max(1) } else { 1 };
+        let (ow, oh) = (width / factor, height / factor);
+        let row_weight = if height == 1 { vec![1.0] } else { (0..height).map(|y| equirect::row_solid_angle(y, height) as f64).collect() };
+        Self {
+            width,
+            height,
+            factor,
+            sanitize,
+            out: vec![Vec4::ZERO; ow as usize * oh as usize],
+            pending: (0..oh).map(|_| None).collect(),
+            arrived: vec![0; oh as usize],
+            row_weight,
+            infinite: Vec::new(),
+            channel_max: [0.0; 3],
+            report: InputReport { sanitized: sanitize, original: (width, height), ..Default::default() },
         }
+    }
+
+    fn push(&mut self, x: u32, y: u32, rgb: [f32; 3]) {
+        if x >= self.width || y >= self.height {
+            return;
+        }
+        let f = self.factor;
+        let ow = (self.width / f) as usize;
+        let (ox, oy) = ((x / f) as usize, (y / f) as usize);
+        let mut c = rgb;
+        let mut infinite = [false; 3];
+        if c.iter().any(|v| v.is_nan()) {
+            self.report.nan += 1;
+        } else if c.iter().any(|v| v.is_infinite()) {
+            self.report.infinite += 1;
+        }
+        let (mut negative, mut clamped) = (false, false);
         for k in 0..3 {
             if c[k].is_finite() {
-                channel_max[k] = channel_max[k].max(c[k]);
+                self.channel_max[k] = self.channel_max[k].max(c[k]);
             }
-        }
-    }
-    if (report.nan > 0 || report.infinite > 0) && !sanitize {
-        return Err(Error::file(
-            path,
-            format!(
-                "has {} texels with NaN and {} with an infinite value; pass --sanitize to replace NaN and -inf by 0 and +inf by the channel's largest finite value",
-                report.nan, report.infinite
-            ),
-        ));
-    }
-    for t in texels.iter_mut() {
-        let mut c = [t.x, t.y, t.z];
-        let mut negative = false;
-        let mut clamped = false;
-        for k in 0..3 {
             if c[k].is_nan() || c[k] == f32::NEG_INFINITY {
                 c[k] = 0.0;
             } else if c[k] == f32::INFINITY {
-                c[k] = channel_max[k];
+                c[k] = 0.0;
+                infinite[k] = true;
             } else if c[k] < 0.0 {
                 c[k] = 0.0;
                 negative = true;
@@ -241,12 +413,77 @@ pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputRe
                 clamped = true;
             }
         }
-        report.negative += negative as u64;
-        report.clamped += clamped as u64;
-        *t = Vec4::new(c[0], c[1], c[2], 1.0);
+        self.report.negative += negative as u64;
+        self.report.clamped += clamped as u64;
+        let w = self.row_weight[y as usize];
+        let mask = (infinite[0] as u8) | (infinite[1] as u8) << 1 | (infinite[2] as u8) << 2;
+        if mask != 0 {
+            self.infinite.push(((oy * ow + ox) as u32, mask, w, clamped));
+        }
+        if f == 1 {
+            self.out[oy * ow + ox] = Vec4::new(c[0], c[1], c[2], 1.0);
+        } else {
+            let row = self.pending[oy].get_or_insert_with(|| vec![0.0; 3 * ow].into_boxed_slice());
+            for k in 0..3 {
+                row[3 * ox + k] += c[k] as f64 * w;
+            }
+        }
+        self.arrived[oy] += 1;
+        if f > 1 && self.arrived[oy] == f * self.width {
+            self.resolve_row(oy);
+        }
     }
-    report.max_value = channel_max.iter().copied().fold(0.0, f32::max);
-    Ok(report)
+
+    /// The total weight of one output texel of row `oy`.
+    fn texel_weight(&self, oy: usize) -> f64 {
+        let f = self.factor as usize;
+        self.row_weight[oy * f..(oy + 1) * f].iter().sum::<f64>() * f as f64
+    }
+
+    fn resolve_row(&mut self, oy: usize) {
+        let ow = (self.width / self.factor) as usize;
+        let total = self.texel_weight(oy);
+        if let Some(row) = self.pending[oy].take() {
+            for ox in 0..ow {
+                let m = |k: usize| (row[3 * ox + k] / total) as f32;
+                self.out[oy * ow + ox] = Vec4::new(m(0), m(1), m(2), 1.0);
+            }
+        }
+    }
+
+    fn finish(mut self, path: &Path) -> Result<(Equirect, InputReport)> {
+        if (self.report.nan > 0 || self.report.infinite > 0) && !self.sanitize {
+            return Err(Error::file(
+                path,
+                format!(
+                    "has {} texels with NaN and {} with an infinite value; pass --sanitize to replace NaN and -inf by 0 and +inf by the channel's largest finite value",
+                    self.report.nan, self.report.infinite
+                ),
+            ));
+        }
+        let (ow, oh) = (self.width / self.factor, self.height / self.factor);
+        for oy in 0..oh as usize {
+            if self.pending[oy].is_some() {
+                // Texels never received (a truncated block) count as black.
+                self.resolve_row(oy);
+            }
+        }
+        let f = self.factor as usize;
+        for &(texel, mask, w, counted) in &self.infinite {
+            let oy = texel as usize / ow as usize;
+            let share = if f == 1 { 1.0 } else { w / self.texel_weight(oy) };
+            let mut clamped = false;
+            for k in (0..3).filter(|k| mask & (1 << k) != 0) {
+                clamped |= self.channel_max[k] > MAX_RADIANCE;
+                let max = self.channel_max[k].min(MAX_RADIANCE);
+                let t = &mut self.out[texel as usize];
+                t[k] = (t[k] as f64 + max as f64 * share) as f32;
+            }
+            self.report.clamped += (clamped && !counted) as u64;
+        }
+        self.report.max_value = self.channel_max.iter().copied().fold(0.0, f32::max);
+        Ok((Equirect { width: ow, height: oh, texels: self.out }, self.report))
+    }
 }
 
 /// The environment `runner` shows when given none: Greg Zaal's "courtyard" (CC0, see
@@ -256,23 +493,25 @@ pub static EMBEDDED_DEFAULT: &[u8] = include_bytes!("../../assets/environments/c
 /// Decodes [`EMBEDDED_DEFAULT`].
 pub fn embedded_default() -> Result<Environment> {
     let path = Path::new("<embedded courtyard.exr>");
-    let (width, height, mut texels) = read_exr(path, EMBEDDED_DEFAULT)?;
-    clean(path, &mut texels, false)?;
-    Ok(Environment::Equirect(Equirect { width, height, texels }))
+    let (image, _) = exr_channels(path, std::io::Cursor::new(EMBEDDED_DEFAULT), false, 1)?;
+    Ok(Environment::Equirect(image))
 }
 
-/// The bytes that identify an environment for the bake cache: the file's bytes, a face
-/// folder's six files in order, or the embedded default.
-pub fn identity_bytes(path: Option<&Path>) -> Result<Vec<u8>> {
+/// What identifies an environment for the bake cache: the BLAKE3 hash of the file's bytes,
+/// of a face folder's six files in order, or of the embedded default, read in a stream.
+pub fn identity(path: Option<&Path>) -> Result<[u8; 32]> {
+    let mut h = blake3::Hasher::new();
     match path {
-        None => Ok(EMBEDDED_DEFAULT.to_vec()),
-        Some(p) if p.is_dir() => {
-            let mut all = Vec::new();
-            for f in face_paths(p)? {
-                all.extend(std::fs::read(&f).map_err(|e| Error::file(&f, format!("cannot read: {e}")))?);
-            }
-            Ok(all)
+        None => {
+            h.update(EMBEDDED_DEFAULT);
         }
-        Some(p) => std::fs::read(p).map_err(|e| Error::file(p, format!("cannot read: {e}"))),
+        Some(p) => {
+            let files = if p.is_dir() { face_paths(p)?.to_vec() } else { vec![p.to_path_buf()] };
+            for f in files {
+                let file = std::fs::File::open(&f).map_err(|e| Error::file(&f, format!("cannot read: {e}")))?;
+                h.update_reader(file).map_err(|e| Error::file(&f, format!("cannot read: {e}")))?;
+            }
+        }
     }
+    Ok(*h.finalize().as_bytes())
 }

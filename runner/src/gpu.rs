@@ -227,10 +227,15 @@ impl Gpu {
         })
     }
 
+    /// The largest buffer this device binds as one storage buffer.
+    pub fn max_binding(&self) -> u64 {
+        let limits = self.device.limits();
+        (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size)
+    }
+
     /// An output storage buffer of `bytes` bytes, checked against the device's limits.
     pub fn output(&self, label: &str, bytes: u64) -> Result<wgpu::Buffer> {
-        let limits = self.device.limits();
-        let max = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let max = self.max_binding();
         if bytes > max {
             return Err(Error::Gpu(format!(
                 "{label} needs {bytes} bytes, more than this device binds in one buffer ({max}); use a smaller size or --backend cpu"

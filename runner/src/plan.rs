@@ -205,11 +205,11 @@ pub fn plan_for(scene: &Scene, env: &crate::environment::Environment, cal: &Cali
 }
 
 /// The environment's own resolution as a cube face size (a quarter of an equirect's width,
-/// as a power of two, at most 1024).
+/// as a power of two, at most `environment::NATIVE_FACE`).
 pub fn native_face_size(env: &crate::environment::Environment) -> u32 {
     match env {
-        crate::environment::Environment::Equirect(e) => (e.width / 4).max(8).next_power_of_two().min(1024),
-        crate::environment::Environment::Cube(c) => c.layout.size.min(1024),
+        crate::environment::Environment::Equirect(e) => (e.width / 4).max(8).next_power_of_two().min(crate::environment::NATIVE_FACE),
+        crate::environment::Environment::Cube(c) => c.layout.size.min(crate::environment::NATIVE_FACE),
     }
 }
 

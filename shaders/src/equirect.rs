@@ -132,6 +132,34 @@ pub fn supersampling(face_size: u32, width: u32, density: f32) -> u32 {
     math::clamp(n, 1.0, 16.0) as u32
 }
 
+/// Solid angle of row `y` of a `height`-row equirect image per unit of longitude (radians):
+/// `cos θ₀ − cos θ₁` over the row's polar span `[πy/h, π(y+1)/h]`, written as
+/// `2·sin(π(y+½)/h)·sin(π/(2h))` so that rows at the poles keep their precision (the
+/// difference of cosines cancels there).
+#[inline]
+pub fn row_solid_angle(y: u32, height: u32) -> f32 {
+    let h = height as f32;
+    let (s_mid, _) = math::sin_cos_turns(0.5 * (y as f32 + 0.5) / h);
+    let (s_half, _) = math::sin_cos_turns(0.25 / h);
+    2.0 * s_mid * s_half
+}
+
+/// The factor (a power of two) by which a `width`×`height` equirect can be reduced, by
+/// area-weighted box filtering, and still resolve a cube of faces `face_size` wide: halve
+/// while both sides stay even and the reduced texel, `2π/width` radians, stays no wider
+/// than a cube texel at its face centre, `2/face_size` (i.e. `width ≥ π·face_size`), times
+/// two for margin: `width/2 ≥ 2π·face_size`. The resampling then still places at least
+/// `2·density` supersampling points per cube texel and axis ([`supersampling`]); what a
+/// finer source would add is below the cube's own resolution.
+pub fn reduction_factor(width: u32, height: u32, face_size: u32) -> u32 {
+    let need = math::TAU * face_size as f32;
+    let mut f = 1;
+    while (width / f) % 2 == 0 && (height / f) % 2 == 0 && (width / f / 2) as f32 >= need {
+        f *= 2;
+    }
+    f
+}
+
 /// Cube texel `(x, y)` of `face` (face size `size`) resampled from the equirect image's row
 /// pyramid (`levels` levels) with an `n×n` grid of solid-angle-weighted samples, each the
 /// mean over its own footprint in `u` ([`sample_area`]): the grid spacing, `2/(size·n)` on
