@@ -34,9 +34,12 @@ fn lut_rejects_bad_sizes_and_counts() {
 
 #[test]
 fn lut_names_an_unwritable_path() {
-    let e = err(&["lut", "--backend", "cpu", "--out", "/no/such/folder/lut.exr"]);
-    assert!(e.contains("/no/such/folder/lut.exr") && e.contains("cannot write"), "{e}");
     let d = scratch("dir");
+    let file = d.join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let under = file.join("lut.exr");
+    let e = err(&["lut", "--backend", "cpu", "--out", under.to_str().unwrap()]);
+    assert!(e.contains(under.to_str().unwrap()) && e.contains("cannot write"), "{e}");
     let e = err(&["lut", "--backend", "cpu", "--out", d.to_str().unwrap()]);
     assert!(e.contains("folder"), "{e}");
 }
@@ -90,4 +93,124 @@ fn lut_writes_exr_and_png() {
 fn missing_gpu_names_the_cpu_backend_and_lavapipe() {
     let e = runner::gpu::Gpu::matching(Some("no-such-adapter-anywhere")).err().expect("no adapter").to_string();
     assert!(e.contains("--backend cpu") && e.contains("mesa-vulkan-drivers"), "{e}");
+}
+
+fn repo(path: &str) -> String {
+    format!("{}/../{path}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn ok(args: &[&str]) {
+    let mut full = vec!["runner"];
+    full.extend_from_slice(args);
+    if let Err(e) = cli::run(full) {
+        panic!("{args:?} failed: {e:#}");
+    }
+}
+
+fn names(dir: &std::path::Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    v.sort();
+    v
+}
+
+/// An output folder is replaced as a unit: a second bake with fewer mips leaves none of
+/// the first bake's extra mips, a scene's bake into a full bake's folder leaves none of
+/// its files, and the parent holds nothing else afterwards (no staging folder).
+#[test]
+fn an_output_folder_is_replaced_whole() {
+    let d = scratch("unit");
+    let out = d.join("out");
+    let (o, env) = (out.to_str().unwrap(), repo("assets/environments/courtyard.exr"));
+    ok(&["bake", &env, "--backend", "cpu", "--size", "32", "--out", o]);
+    assert!(out.join("specular_mip1.exr").exists() && out.join("sh9.json").exists());
+    ok(&["bake", &env, "--backend", "cpu", "--size", "32", "--mips", "1", "--out", o]);
+    let after = names(&out);
+    assert!(after.contains(&"specular_mip0.exr".to_string()) && !after.iter().any(|n| n == "specular_mip1.exr"), "{after:?}");
+    let cache = d.join("cache");
+    ok(&["bake", "--scene", &repo("scenes/brushed-metal.toml"), "--backend", "cpu", "--cache", cache.to_str().unwrap(), "--out", o]);
+    assert_eq!(names(&out), ["brdf_lut.exr", "plan.json", "specular.ktx2"]);
+    assert_eq!(names(&d), ["cache", "out"]);
+}
+
+/// A failed bake creates no folder; `--out` naming a file, or a folder of someone else's
+/// files, is refused before any work with a message naming the flag.
+#[test]
+fn output_folder_mistakes_are_refused_in_the_users_terms() {
+    let d = scratch("outerr");
+    let missing = d.join("new").join("deeper");
+    let e = err(&["bake", "no-such.exr", "--backend", "cpu", "--out", missing.to_str().unwrap()]);
+    assert!(e.contains("no-such.exr"), "{e}");
+    assert!(!d.join("new").exists(), "a failed bake left {:?}", names(&d));
+    let file = d.join("file.txt");
+    std::fs::write(&file, "mine").unwrap();
+    let e = err(&["bake", &repo("assets/environments/courtyard.exr"), "--out", file.to_str().unwrap()]);
+    assert!(e.contains("--out") && e.contains("existing file"), "{e}");
+    let theirs = d.join("theirs");
+    std::fs::create_dir_all(&theirs).unwrap();
+    std::fs::write(theirs.join("notes.txt"), "mine").unwrap();
+    let e = err(&["bake", &repo("assets/environments/courtyard.exr"), "--out", theirs.to_str().unwrap()]);
+    assert!(e.contains("--out") && e.contains("notes.txt"), "{e}");
+    assert_eq!(std::fs::read_to_string(theirs.join("notes.txt")).unwrap(), "mine");
+}
+
+/// Messages name what the user wrote: a small `--size` bakes (the irradiance and SH9
+/// sources follow it unless given), `--samples -1` and `--lut-size 0` name the flag and
+/// value, a scene's `samples = 0` names the scene field, and flags beside `--scene` that the
+/// scene sets are refused by name, even when equal to their defaults.
+#[test]
+fn messages_name_the_users_own_input() {
+    let d = scratch("msgs");
+    let env = repo("assets/environments/courtyard.exr");
+    ok(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", d.join("small").to_str().unwrap()]);
+    let e = err(&["bake", &env, "--samples", "-1"]);
+    assert!(e.contains("--samples") && e.contains("-1") && !e.contains("-- -1"), "{e}");
+    let e = err(&["bake", &env, "--lut-size", "0"]);
+    assert!(e.contains("--lut-size") && e.contains("not 0"), "{e}");
+    let scene = d.join("zero.toml");
+    std::fs::write(
+        &scene,
+        format!("environment = {env:?}\n[quality]\nsamples = 0\n[[materials]]\nname = \"m\"\n[[objects]]\nkind = \"sphere-grid\"\nmaterial = \"m\"\n"),
+    )
+    .unwrap();
+    let e = err(&["plan", scene.to_str().unwrap()]);
+    assert!(e.contains("[quality] samples") && !e.contains("--samples"), "{e}");
+    let e = err(&["render", "--scene", &repo("scenes/brushed-metal.toml"), "--yaw", "20", "--width", "960"]);
+    assert!(e.contains("--yaw") && e.contains("--width"), "{e}");
+    let e = err(&["bake", "--scene", &repo("scenes/brushed-metal.toml"), "--samples", "64"]);
+    assert!(e.contains("--samples"), "{e}");
+    let e = err(&["render", "--out", d.join("f.bmp").to_str().unwrap()]);
+    assert!(e.contains("--out") && e.contains(".png or .jpg"), "{e}");
+}
+
+/// `render --out x.jpg` writes a JPEG, and `lut --out` creates missing folders as `bake` does.
+#[test]
+fn outputs_follow_their_names() {
+    let d = scratch("names");
+    let jpg = d.join("frame.jpg");
+    ok(&["render", "--backend", "cpu", "--width", "64", "--height", "32", "--size", "16", "--samples", "16", "--no-model", "--out", jpg.to_str().unwrap()]);
+    assert_eq!(&std::fs::read(&jpg).unwrap()[..3], &[0xFF, 0xD8, 0xFF], "JPEG signature");
+    let deep = d.join("a").join("b").join("lut.exr");
+    ok(&["lut", "--backend", "cpu", "--size", "8", "--out", deep.to_str().unwrap()]);
+    assert!(deep.exists());
+}
+
+/// A bake estimated at over an hour is refused before it starts, with the estimate and the
+/// flags that set it, unless `--force`.
+#[test]
+fn runs_estimated_over_an_hour_are_refused() {
+    let env = repo("assets/environments/courtyard.exr");
+    let e = err(&["bake", &env, "--backend", "cpu", "--size", "2048", "--samples", "1048576", "--sampled-only"]);
+    assert!(e.contains("estimated to take") && e.contains("--samples") && e.contains("--force"), "{e}");
+    let e = err(&["lut", "--backend", "cpu", "--size", "4096", "--method", "sampled", "--samples", "100000000"]);
+    assert!(e.contains("estimated to take") && e.contains("--samples") && e.contains("--force"), "{e}");
+}
+
+/// A glTF whose meshes are Draco-compressed is refused up front, naming the extension.
+#[test]
+fn draco_models_are_refused_naming_the_extension() {
+    let d = scratch("draco");
+    let model = d.join("draco.gltf");
+    std::fs::write(&model, r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],"accessors":[{"componentType":5126,"count":3,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}"#).unwrap();
+    let e = format!("{}", runner::model::load(&model).map(|_| ()).expect_err("refused"));
+    assert!(e.contains("KHR_draco_mesh_compression") && !e.contains("Missing data"), "{e}");
 }

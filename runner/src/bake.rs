@@ -175,7 +175,7 @@ impl Settings {
             return Err(Error::Invalid(format!("--mips must be from 1 to {max_mips} for --size {}, not {}", self.size, self.mips)));
         }
         if self.samples == 0 {
-            return Err(Error::Invalid("--samples must be at least 1".into()));
+            return Err(Error::Invalid("--samples must be at least 1, not 0".into()));
         }
         if !(1..=4).contains(&self.sample_growth) {
             return Err(Error::Invalid(format!("--sample-growth must be from 1 to 4, not {}", self.sample_growth)));
@@ -186,8 +186,11 @@ impl Settings {
         if !(self.supersample_density > 0.0 && self.supersample_density <= 16.0) {
             return Err(Error::Invalid(format!("--supersample must be in (0, 16], not {}", self.supersample_density)));
         }
-        if self.lut_size == 0 || self.lut_size > crate::backend::MAX_LUT_SIZE || self.lut_samples == 0 {
-            return Err(Error::Invalid("--lut-size must be 1..4096 and --lut-samples at least 1".into()));
+        if self.lut_size == 0 || self.lut_size > crate::backend::MAX_LUT_SIZE {
+            return Err(Error::Invalid(format!("--lut-size must be from 1 to {}, not {}", crate::backend::MAX_LUT_SIZE, self.lut_size)));
+        }
+        if self.lut_samples == 0 {
+            return Err(Error::Invalid("--lut-samples must be at least 1, not 0".into()));
         }
         if self.lut_method == TableMethod::Sampled && self.lut_masking != MaskingModel::Schlick {
             return Err(Error::Invalid("--lut-masking correlated needs --lut-method quadrature (the sampled table is Smith–Schlick only)".into()));
@@ -286,11 +289,52 @@ pub struct Baked {
     pub timings: Vec<Timing>,
 }
 
-fn timed<T>(timings: &mut Vec<Timing>, product: &'static str, f: impl FnOnce() -> Result<T>) -> Result<T> {
+/// Runs step `product`, estimated at `estimates` (see [`step_estimates`]), with its
+/// progress shown, and records its wall time.
+fn timed<T>(timings: &mut Vec<Timing>, product: &'static str, estimates: &[f64; 4], f: impl FnOnce() -> Result<T>) -> Result<T> {
+    let estimate = crate::plan::STEPS.iter().position(|s| *s == product).map(|k| estimates[k]);
+    let _step = crate::progress::step(product, estimate);
     let start = Instant::now();
     let r = f()?;
     timings.push(Timing { product, seconds: start.elapsed().as_secs_f64() });
     Ok(r)
+}
+
+/// Estimated seconds of each of `plan::STEPS` when baking `products` (and `levels` of the
+/// specular cube) of `env` with `settings` on `backend` (the built-in calibration: lavapipe
+/// for the GPU backend, 2 cores for the CPU).
+pub fn step_estimates(backend: &Backend, env: &Environment, settings: &Settings, products: Products, levels: &[u32]) -> [f64; 4] {
+    let width = match env {
+        Environment::Equirect(e) => e.width,
+        Environment::Cube(_) => 0,
+    };
+    crate::plan::step_seconds(settings, products, levels, width, &crate::plan::Calibration::default(), matches!(backend, Backend::Gpu(_)))
+}
+
+/// Runs estimated over this many seconds are refused unless forced.
+pub const MAX_UNFORCED_SECONDS: f64 = 3600.0;
+
+/// Refuses a bake estimated (`estimates`, see [`step_estimates`]) to take over an hour,
+/// unless `force`: naming the estimate, its longest step and the flags that set it.
+pub fn check_duration(estimates: &[f64; 4], force: bool) -> Result<()> {
+    let total: f64 = estimates.iter().sum();
+    if total <= MAX_UNFORCED_SECONDS || force {
+        return Ok(());
+    }
+    let (k, longest) = estimates.iter().copied().enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).expect("four steps");
+    let knobs = [
+        "--source-size and --supersample",
+        "--samples, --sample-growth and --size",
+        "--lut-size and --lut-samples",
+        "--irradiance-size and --irradiance-source",
+    ];
+    Err(Error::Invalid(format!(
+        "this bake is estimated to take {} ({} of it for the {}); lower {} (scene: [quality]), or pass --force to run it anyway",
+        crate::progress::seconds(total),
+        crate::progress::seconds(longest),
+        crate::plan::STEPS[k],
+        knobs[k]
+    )))
 }
 
 /// The source cube of `env` for `settings`: resampled from an equirect, or the given faces
@@ -330,10 +374,11 @@ pub fn brdf_table(backend: &Backend, settings: &Settings) -> Result<Lut> {
 pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products: Products) -> Result<Baked> {
     settings.validate()?;
     let mut timings = Vec::new();
-    let source = timed(&mut timings, "source cube", || source_cube(backend, env, settings))?;
+    let all: Vec<u32> = (0..settings.mips).collect();
+    let est = step_estimates(backend, env, settings, products, &all);
+    let source = timed(&mut timings, "source cube", &est, || source_cube(backend, env, settings))?;
     let specular = if products.specular {
-        Some(timed(&mut timings, "specular", || {
-            let all: Vec<u32> = (0..settings.mips).collect();
+        Some(timed(&mut timings, "specular", &est, || {
             backend.prefilter_levels(
                 &source,
                 settings.specular_layout(),
@@ -349,17 +394,17 @@ pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products:
     };
     let irradiance = if products.irradiance {
         let level = level_of_size(source.layout, settings.irradiance_source);
-        Some(timed(&mut timings, "irradiance", || backend.irradiance(&source, level, settings.irradiance_size))?)
+        Some(timed(&mut timings, "irradiance", &est, || backend.irradiance(&source, level, settings.irradiance_size))?)
     } else {
         None
     };
     let sh9 = if products.sh9 {
         let level = level_of_size(source.layout, settings.sh_source);
-        Some(timed(&mut timings, "sh9", || backend.sh9(&source, level))?)
+        Some(timed(&mut timings, "sh9", &est, || backend.sh9(&source, level))?)
     } else {
         None
     };
-    let lut = if products.lut { Some(timed(&mut timings, "brdf lut", || brdf_table(backend, settings))?) } else { None };
+    let lut = if products.lut { Some(timed(&mut timings, "brdf lut", &est, || brdf_table(backend, settings))?) } else { None };
     Ok(Baked { source, specular, irradiance, sh9, lut, timings })
 }
 
@@ -469,6 +514,7 @@ struct ShFile<'a> {
 /// Writes every baked product into `dir` (created if missing), each file atomically, and
 /// `bake.json` last.
 pub fn write(dir: &Path, baked: &Baked, settings: &Settings, manifest_base: Manifest) -> Result<Manifest> {
+    let _step = crate::progress::step("writing the files", None);
     std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, format!("cannot create the output folder: {e}")))?;
     let mut manifest = manifest_base;
     let mut files_out = Vec::new();
@@ -553,10 +599,12 @@ pub const CONVENTIONS: [&str; 5] = [
     "half-float overflow: values above 65504 are clamped and counted (format rgba16f) or kept in rgba32f (format auto)",
 ];
 
-/// Bakes what the display reads (specular cube, irradiance cube, BRDF table) of `env`.
+/// What the display reads: the specular cube, the irradiance cube and the BRDF table.
+pub const DISPLAY_PRODUCTS: Products = Products { specular: true, irradiance: true, sh9: false, lut: true };
+
+/// Bakes what the display reads ([`DISPLAY_PRODUCTS`]) of `env`.
 pub fn bake_for_display(backend: &Backend, env: &Environment, settings: &Settings) -> Result<crate::render::BakedEnvironment> {
-    let products = Products { specular: true, irradiance: true, sh9: false, lut: true };
-    let baked = bake(backend, env, settings, products)?;
+    let baked = bake(backend, env, settings, DISPLAY_PRODUCTS)?;
     Ok(crate::render::BakedEnvironment {
         source: baked.source,
         specular: baked.specular.expect("baked"),
@@ -603,9 +651,10 @@ pub fn bake_plan(backend: &Backend, env: &Environment, plan: &crate::plan::Plan)
     let s = &plan.settings;
     s.validate()?;
     let mut timings = Vec::new();
-    let source = timed(&mut timings, "source cube", || source_cube(backend, env, s))?;
+    let est = step_estimates(backend, env, s, plan.products, &plan.levels);
+    let source = timed(&mut timings, "source cube", &est, || source_cube(backend, env, s))?;
     let specular = if plan.products.specular {
-        timed(&mut timings, "specular", || {
+        timed(&mut timings, "specular", &est, || {
             backend.prefilter_levels(&source, s.specular_layout(), &s.roughness(), &plan.levels, &s.samples_per_mip(), s.exact_sums, s.lod_bias)
         })?
     } else {
@@ -613,11 +662,12 @@ pub fn bake_plan(backend: &Backend, env: &Environment, plan: &crate::plan::Plan)
     };
     let irradiance = if plan.products.irradiance {
         let level = level_of_size(source.layout, s.irradiance_source);
-        timed(&mut timings, "irradiance", || backend.irradiance(&source, level, s.irradiance_size))?
+        timed(&mut timings, "irradiance", &est, || backend.irradiance(&source, level, s.irradiance_size))?
     } else {
         empty_cube()
     };
-    let lut = if plan.products.lut { timed(&mut timings, "brdf lut", || brdf_table(backend, s))? } else { Lut { size: 1, texels: vec![Default::default()] } };
+    let lut =
+        if plan.products.lut { timed(&mut timings, "brdf lut", &est, || brdf_table(backend, s))? } else { Lut { size: 1, texels: vec![Default::default()] } };
     let source = Cube { layout: CubeLayout::new(source.layout.size, 1), texels: source.level(0).to_vec() };
     Ok((crate::render::BakedEnvironment { source, specular, irradiance, lut, mapping: s.mapping.into() }, timings))
 }
@@ -641,6 +691,8 @@ pub fn bake_scene(
     let plan_json = serde_json::to_string(&(&plan.settings, &plan.products, &plan.levels, scene.sanitize)).expect("serialisable");
     let key = crate::cache::key(&identity, &plan_json, &backend.identity());
     let mut outcome = if force { Outcome::Forced } else { Outcome::Baked };
+    // Held until this bake is stored: a concurrent run of the same key waits, then hits.
+    let _lock = cache.map(|c| c.lock(&key)).transpose()?;
     if let (Some(c), false) = (cache, force) {
         match c.get(&key) {
             crate::cache::Lookup::Hit(env) => return Ok(SceneBake { plan, env: *env, key, outcome: Outcome::CacheHit, timings: Vec::new() }),
@@ -648,6 +700,7 @@ pub fn bake_scene(
             crate::cache::Lookup::Rejected(why) => outcome = Outcome::Rebuilt(why),
         }
     }
+    check_duration(&step_estimates(backend, &env, &plan.settings, plan.products, &plan.levels), force)?;
     let (baked, timings) = bake_plan(backend, &env, &plan)?;
     if let Some(c) = cache {
         c.put(&key, &baked)?;

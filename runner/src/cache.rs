@@ -107,6 +107,30 @@ impl Cache {
         self.dir.join(key)
     }
 
+    /// Takes the lock of entry `key` (a `.lock` file beside it, locked exclusively by the
+    /// operating system, so a crashed holder releases it): concurrent runs that bake the
+    /// same key take turns, and each after the first finds the entry the first stored. Says
+    /// on stderr when it has to wait. Held until the returned file is dropped.
+    pub fn lock(&self, key: &str) -> Result<std::fs::File> {
+        std::fs::create_dir_all(&self.dir).map_err(|e| Error::file(&self.dir, format!("cannot create the cache folder: {e}")))?;
+        let path = self.dir.join(format!("{key}.lock"));
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map_err(|e| Error::file(&path, format!("cannot open the cache lock: {e}")))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                eprintln!("waiting for another run that bakes the same scene (cache lock {})", path.display());
+                file.lock().map_err(|e| Error::file(&path, format!("cannot lock: {e}")))?;
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(Error::file(&path, format!("cannot lock: {e}"))),
+        }
+        Ok(file)
+    }
+
     /// Looks up `key`, checking the manifest's key and every file's hash.
     pub fn get(&self, key: &str) -> Lookup {
         let dir = self.entry(key);

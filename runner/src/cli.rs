@@ -221,7 +221,7 @@ pub struct DisplayBakeArgs {
     #[arg(long, default_value_t = 128)]
     pub size: u32,
     /// GGX samples per specular texel.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 256)]
     pub samples: u32,
     /// Replace NaN/inf texels instead of refusing the environment.
     #[arg(long)]
@@ -244,7 +244,7 @@ struct RenderArgs {
     env: Option<PathBuf>,
     #[command(flatten)]
     scene: SceneArgs,
-    /// Output PNG.
+    /// Output image: .png, or .jpg (JPEG, quality 95).
     #[arg(long, default_value = "frame.png")]
     out: PathBuf,
     /// Width in pixels.
@@ -279,7 +279,7 @@ pub struct QualityArgs {
     pub mapping: Mapping,
     /// GGX samples per texel of specular mip 1 (the default, with --sample-growth 2, is the
     /// best end-to-end error per millisecond measured by `runner report` on city.exr).
-    #[arg(long, default_value_t = 64)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 64)]
     pub samples: u32,
     /// Factor by which the sample count grows per mip after mip 1 (1 = the same on every mip).
     #[arg(long, default_value_t = 2)]
@@ -298,18 +298,19 @@ pub struct QualityArgs {
     /// Face size of the irradiance cube.
     #[arg(long, default_value_t = 32)]
     pub irradiance_size: u32,
-    /// Face size of the source mip the irradiance convolution sums over.
-    #[arg(long, default_value_t = 16)]
-    pub irradiance_source: u32,
+    /// Face size of the source mip the irradiance convolution sums over [default: 16, or
+    /// the source size if smaller].
+    #[arg(long)]
+    pub irradiance_source: Option<u32>,
     /// Face size of the source mip projected onto SH9 (SH9's error is its band limit from
-    /// 16² up).
-    #[arg(long, default_value_t = 32)]
-    pub sh_source: u32,
+    /// 16² up) [default: 32, or the source size if smaller].
+    #[arg(long)]
+    pub sh_source: Option<u32>,
     /// Width and height of the BRDF table.
     #[arg(long, default_value_t = 256)]
     pub lut_size: u32,
     /// Samples per texel of the BRDF table (with --lut-method sampled).
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1024)]
     pub lut_samples: u32,
     /// How the BRDF table is integrated: deterministic quadrature (within 1e-5) or sampling.
     #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
@@ -327,9 +328,11 @@ impl QualityArgs {
     /// The bake settings these flags describe.
     pub fn settings(&self) -> Settings {
         let mips = self.mips.unwrap_or_else(|| Settings::default_mips(self.size));
+        let source_size = self.source_size.unwrap_or(self.size);
+        let d = Settings::default();
         Settings {
             size: self.size,
-            source_size: self.source_size.unwrap_or(self.size),
+            source_size,
             mips,
             mapping: self.mapping,
             samples: self.samples,
@@ -338,8 +341,9 @@ impl QualityArgs {
             lod_bias: self.lod_bias,
             supersample_density: self.supersample,
             irradiance_size: self.irradiance_size,
-            irradiance_source: self.irradiance_source,
-            sh_source: self.sh_source,
+            // Defaults that exceed a small source are fitted to it; given values are checked.
+            irradiance_source: self.irradiance_source.unwrap_or(d.irradiance_source.min(source_size)),
+            sh_source: self.sh_source.unwrap_or(d.sh_source.min(source_size)),
             lut_size: self.lut_size,
             lut_samples: self.lut_samples,
             lut_method: self.lut_method,
@@ -383,6 +387,9 @@ struct BenchArgs {
     /// Runs per backend; the table shows the fastest.
     #[arg(long, default_value_t = 1)]
     runs: u32,
+    /// Run even if the bake is estimated to take over an hour.
+    #[arg(long)]
+    force: bool,
 }
 
 #[derive(Args)]
@@ -398,7 +405,7 @@ struct LutArgs {
     #[arg(long, value_enum)]
     masking: Option<MaskingModel>,
     /// Hammersley points per texel (with --method sampled).
-    #[arg(long, default_value_t = 1024)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1024)]
     samples: u32,
     /// Where to bake.
     #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
@@ -409,7 +416,25 @@ struct LutArgs {
     /// Also write an 8-bit PNG preview beside it (same name, .png).
     #[arg(long)]
     png: bool,
+    /// Run even if the table is estimated to take over an hour.
+    #[arg(long)]
+    force: bool,
 }
+
+/// With `--scene`, the scene file sets everything but where and how to run: refuses any
+/// other flag in `given`, naming them and the scene tables that set them.
+fn refuse_beside_scene(given: &[String], allowed: &[&str]) -> anyhow::Result<()> {
+    let extra: Vec<&str> = given.iter().map(String::as_str).filter(|f| !allowed.contains(f) && *f != "--scene" && *f != "--env").collect();
+    anyhow::ensure!(
+        extra.is_empty(),
+        "with --scene, the scene file sets the environment, [quality], [camera], [output] and the materials: drop {} (or edit the scene)",
+        extra.join(", ")
+    );
+    Ok(())
+}
+
+/// The flags that still apply beside `--scene`: where and how to run, and the cache.
+const SCENE_FLAGS: [&str; 6] = ["--force", "--cache", "--calibration", "--out", "--backend", "--format"];
 
 /// Parses `args` (the program name first) and runs the command.
 pub fn run<I, T>(args: I) -> anyhow::Result<()>
@@ -417,13 +442,31 @@ where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
-    let cli = Cli::try_parse_from(args)?;
+    use clap::{CommandFactory, FromArgMatches};
+    let matches = Cli::command().try_get_matches_from(args)?;
+    let cli = Cli::from_arg_matches(&matches)?;
+    // The flags written on the command line (not defaulted), as the user wrote them.
+    let given: Vec<String> = matches
+        .subcommand()
+        .map(|(name, sub)| {
+            let command = Cli::command();
+            let args: Vec<String> = command
+                .find_subcommand(name)
+                .map(|c| c.get_arguments().filter_map(|a| a.get_long().map(|l| (a.get_id().to_string(), l))).map(|(id, _)| id).collect())
+                .unwrap_or_default();
+            sub.ids()
+                .filter(|id| args.iter().any(|a| a == id.as_str()))
+                .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
+                .map(|id| format!("--{}", id.as_str().replace('_', "-")))
+                .collect()
+        })
+        .unwrap_or_default();
     match cli.command {
         Some(Command::Lut(args)) => lut(args),
-        Some(Command::Bake(args)) => bake_command(args),
+        Some(Command::Bake(args)) => bake_command(args, &given),
         Some(Command::Bench(args)) => bench(args),
-        Some(Command::Render(args)) => render(args),
-        Some(Command::View(args)) => view(args),
+        Some(Command::Render(args)) => render(args, &given),
+        Some(Command::View(args)) => view(args, &given),
         Some(Command::Report(args)) => report(args),
         Some(Command::Plan(args)) => plan_command(args),
         None => default_run(),
@@ -446,6 +489,10 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     if settings.lut_method == TableMethod::Sampled && settings.lut_masking != MaskingModel::Schlick {
         anyhow::bail!("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)");
     }
+    let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };
+    let mut estimate = crate::plan::step_seconds(&settings, only_table, &[], 0, &crate::plan::Calibration::default(), matches!(backend, Backend::Gpu(_)));
+    estimate[0] = 0.0; // the cost model's source cube: a table needs none
+    bake::check_duration(&estimate, args.force).map_err(|e| anyhow::anyhow!(e.to_string().replace("--lut-size and --lut-samples", "--size and --samples")))?;
     let lut = bake::brdf_table(&backend, &settings)?;
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
@@ -458,26 +505,25 @@ fn lut(args: LutArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
+fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
     if let Some(scene_path) = &args.scene.scene {
         anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
-        anyhow::ensure!(
-            args.quality.settings() == Settings { format: args.quality.format, ..Settings::default() } && !args.sanitize,
-            "with --scene, the bake settings come from the scene's [quality] table (and `sanitize = true`): drop the quality flags"
-        );
-        std::fs::create_dir_all(&args.out).map_err(|e| crate::Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
-        files::check_writable(&args.out.join("bake.json"))?;
+        refuse_beside_scene(given, &SCENE_FLAGS)?;
+        let out = files::OutputDir::begin(&args.out, "--out")?;
         let backend = Backend::open(args.backend)?;
         let (_, sb) = args.scene.bake(scene_path, &backend)?;
-        return write_scene_bake(&args.out, &sb, &args.quality.format);
+        write_scene_bake(&out, &sb, &args.quality.format)?;
+        out.commit()?;
+        return Ok(());
     }
     let env_path = args.env.clone().expect("clap requires ENV without --scene");
     let settings = args.quality.settings();
     settings.validate()?;
-    std::fs::create_dir_all(&args.out).map_err(|e| crate::Error::file(&args.out, format!("cannot create the output folder: {e}")))?;
-    files::check_writable(&args.out.join("bake.json"))?;
+    let out = files::OutputDir::begin(&args.out, "--out")?;
     let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
     let backend = Backend::open(args.backend)?;
+    let all: Vec<u32> = (0..settings.mips).collect();
+    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, Products::ALL, &all), args.scene.force)?;
     println!("baking {} on {}", env_path.display(), backend.describe());
     let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
     let manifest = bake::Manifest {
@@ -493,13 +539,18 @@ fn bake_command(args: BakeArgs) -> anyhow::Result<()> {
         files: Vec::new(),
         conventions: bake::CONVENTIONS.to_vec(),
     };
-    let manifest = bake::write(&args.out, &baked, &settings, manifest)?;
+    let manifest = bake::write(out.path(), &baked, &settings, manifest)?;
+    out.commit()?;
     for t in &manifest.timings {
         println!("  {:<12} {:>9.3} s", t.product, t.seconds);
     }
     println!("  {:<12} {:>9.3} s", "total", manifest.timings.iter().map(|t| t.seconds).sum::<f64>());
     if let Some(e) = manifest.sh9_vs_convolution {
-        println!("  SH9 irradiance vs the convolution: max relative error {:.1} %, rms {:.1} %", 100.0 * e.max_relative, 100.0 * e.rms_relative);
+        println!(
+            "  sh9.json (9 coefficients, a band-limited stand-in for irradiance.ktx2) against the convolution: max relative error {:.1} %, rms {:.1} % over the irradiance texels; small bright sources exceed what 9 coefficients hold, prefer irradiance.ktx2",
+            100.0 * e.max_relative,
+            100.0 * e.rms_relative
+        );
     }
     println!("wrote {} files to {}", manifest.files.len() + 1, args.out.display());
     Ok(())
@@ -529,6 +580,8 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 continue;
             }
         };
+        let all: Vec<u32> = (0..settings.mips).collect();
+        bake::check_duration(&bake::step_estimates(&backend, &env, &settings, Products::ALL, &all), args.force)?;
         let mut best: Vec<bake::Timing> = Vec::new();
         for _ in 0..args.runs.max(1) {
             let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
@@ -552,7 +605,10 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
 /// Reads the environment at `path` for cubes of faces up to `face`
 /// (`environment::load_for`), saying on stderr what reading it changed.
 pub fn load_input(path: &std::path::Path, sanitize: bool, face: u32) -> anyhow::Result<(environment::Environment, environment::InputReport)> {
-    let (env, input) = environment::load_for(path, sanitize, face)?;
+    let (env, input) = {
+        let _step = crate::progress::step(&format!("reading {}", path.display()), None);
+        environment::load_for(path, sanitize, face)?
+    };
     let p = path.display();
     if input.negative > 0 {
         eprintln!("note: {p}: {} texels had negative values, set to 0", input.negative);
@@ -585,14 +641,12 @@ pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyho
     }
 }
 
-fn render(args: RenderArgs) -> anyhow::Result<()> {
+fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
+    let format = files::picture_format(&args.out, "--out")?;
     files::check_writable(&args.out)?;
     if let Some(scene_path) = &args.scene.scene {
         anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
-        anyhow::ensure!(
-            (args.width, args.height, args.bake.size, args.bake.samples, args.bake.sanitize) == (960, 540, 128, 256, false),
-            "with --scene, the size comes from the scene's [output] and the bake from its [quality]: drop --width, --height, --size, --samples, --sanitize"
-        );
+        refuse_beside_scene(given, &SCENE_FLAGS)?;
         let backend = Backend::open(args.backend)?;
         let (scene, sb) = args.scene.bake(scene_path, &backend)?;
         let view = scene.view(sb.env.auto_exposure());
@@ -600,7 +654,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let (w, h) = (scene.output.width, scene.output.height);
         let start = Instant::now();
         let pixels = render_frame(&backend, &sb.env, &view.frame(sb.env.shape(), w, h, true), model.as_ref())?;
-        files::write_png(&args.out, w, h, &crate::render::to_rgb8(&pixels))?;
+        files::write_rgb8(&args.out, w, h, &crate::render::to_rgb8(&pixels), format)?;
         println!("rendered {w}×{h} in {:.3} s: {}", start.elapsed().as_secs_f64(), view.summary());
         println!("wrote {}", args.out.display());
         return Ok(());
@@ -608,8 +662,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     crate::render::check_size(args.width, args.height)?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(args.backend)?;
+    let settings = args.bake.settings(&env);
+    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &(0..settings.mips).collect::<Vec<_>>()), args.scene.force)?;
     let start = Instant::now();
-    let baked = bake::bake_for_display(&backend, &env, &args.bake.settings(&env))?;
+    let baked = bake::bake_for_display(&backend, &env, &settings)?;
     let bake_secs = start.elapsed().as_secs_f64();
     let view = args.look.view(baked.auto_exposure());
     let model = args.look.load_model()?;
@@ -617,19 +673,22 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let frame = view.frame(baked.shape(), args.width, args.height, true);
     let pixels = render_frame(&backend, &baked, &frame, model.as_ref())?;
     let render_secs = start.elapsed().as_secs_f64();
-    files::write_png(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels))?;
+    files::write_rgb8(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels), format)?;
     println!("{name} on {}: bake {bake_secs:.2} s, render {render_secs:.3} s", backend.describe());
     println!("{}", view.summary());
     println!("wrote {}", args.out.display());
     Ok(())
 }
 
-fn view(args: ViewArgs) -> anyhow::Result<()> {
+fn view(args: ViewArgs, given: &[String]) -> anyhow::Result<()> {
+    if args.scene.scene.is_some() {
+        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        refuse_beside_scene(given, &["--force", "--cache", "--calibration", "--exit-after"])?;
+    }
     if !crate::view::display_available() {
         anyhow::bail!("no display (neither DISPLAY nor WAYLAND_DISPLAY is set); `runner render --out frame.png` renders without one");
     }
     if let Some(scene_path) = &args.scene.scene {
-        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
         let backend = Backend::open(BackendKind::Gpu)?;
         let (scene, sb) = args.scene.bake(scene_path, &backend)?;
         let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
@@ -646,8 +705,10 @@ fn view(args: ViewArgs) -> anyhow::Result<()> {
     crate::render::check_size(args.width, args.height)?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(BackendKind::Gpu)?;
+    let settings = args.bake.settings(&env);
+    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &(0..settings.mips).collect::<Vec<_>>()), args.scene.force)?;
     let start = Instant::now();
-    let baked = bake::bake_for_display(&backend, &env, &args.bake.settings(&env))?;
+    let baked = bake::bake_for_display(&backend, &env, &settings)?;
     println!("{name} baked on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
     let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
     let state = args.look.view(baked.auto_exposure());
@@ -737,7 +798,9 @@ fn report(args: ReportArgs) -> anyhow::Result<()> {
     anyhow::ensure!(!backends.is_empty(), "no backend could be opened");
     let sweep = if args.quick { crate::report::Sweep::quick() } else { crate::report::Sweep::full() };
     let start = Instant::now();
-    let rows = crate::report::run(&env, &name, &backends, &sweep, &args.out)?;
+    let out = files::OutputDir::begin(&args.out, "--out")?;
+    let rows = crate::report::run(&env, &name, &backends, &sweep, out.path())?;
+    out.commit()?;
     println!("{} measurements in {:.1} s", rows.len(), start.elapsed().as_secs_f64());
     for r in crate::report::best_per_ms(&rows) {
         println!("  best error per ms: {:<28} {:<8} {:<24} {:>9.1} ms  mean error {:.2e}", r.product, &r.backend[..3], r.setting, r.time_ms, r.mean_error);
@@ -779,7 +842,8 @@ fn plan_command(args: PlanArgs) -> anyhow::Result<()> {
 /// `plan.json` (decisions, settings, levels, cache key). `specular.ktx2` holds the baked
 /// mips `first ..= last` only (its mip 0 is level `first`; roughness per mip in
 /// `plan.json`; levels in between that the plan skips are zero).
-fn write_scene_bake(dir: &std::path::Path, sb: &bake::SceneBake, format: &Format) -> anyhow::Result<()> {
+fn write_scene_bake(out: &files::OutputDir, sb: &bake::SceneBake, format: &Format) -> anyhow::Result<()> {
+    let dir = out.path();
     let p = &sb.plan;
     let mut written = Vec::new();
     let all_roughness = p.settings.roughness();
@@ -809,6 +873,10 @@ fn write_scene_bake(dir: &std::path::Path, sb: &bake::SceneBake, format: &Format
     let file = PlanFile { key: &sb.key, plan: p, specular_roughness_per_mip: specular_roughness, timings: &sb.timings, files: &written };
     let json = serde_json::to_string_pretty(&file).expect("serialisable");
     files::write_atomic(&dir.join("plan.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
-    println!("wrote {} and plan.json to {}", if written.is_empty() { "nothing to bake".to_string() } else { written.join(", ") }, dir.display());
+    if written.is_empty() {
+        println!("the plan bakes nothing for this scene: wrote only plan.json (its decisions) to {}", out.target().display());
+    } else {
+        println!("wrote {} and plan.json to {}", written.join(", "), out.target().display());
+    }
     Ok(())
 }

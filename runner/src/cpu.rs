@@ -1,23 +1,14 @@
 //! The CPU backend: the same `splitsum_shaders` functions the kernels call, run natively
 //! over every texel with rayon, with a progress bar on work that takes a while.
 
+use crate::progress::bar as progress;
 use crate::texture::{Cube, Equirect, Lut};
-use indicatif::{ProgressBar, ProgressStyle};
+use indicatif::ProgressBar;
 use rayon::prelude::*;
 use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
 use splitsum_shaders::glam::{Vec2, Vec4};
 use splitsum_shaders::irradiance::{self, SH9};
 use splitsum_shaders::{equirect, lut, prefilter};
-
-/// A progress bar of `len` steps named `what`; hidden when stderr is not a terminal.
-pub fn progress(what: &str, len: u64) -> ProgressBar {
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template("{prefix:>12} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})").expect("valid template").progress_chars("=> "),
-    );
-    bar.set_prefix(what.to_string());
-    bar
-}
 
 /// A `size`×`size` table, `f(x, y)` per texel, one rayon task per row.
 fn table(what: &str, size: u32, f: impl Fn(u32, u32) -> Vec2 + Sync) -> Lut {

@@ -20,6 +20,7 @@ pub mod model;
 pub mod plan;
 pub mod plot;
 pub mod preview;
+pub mod progress;
 pub mod raster;
 pub mod render;
 pub mod report;

@@ -117,8 +117,30 @@ pub const PLACE_BESIDE_GRID: (Vec3, f32) = (Vec3::new(5.4, 0.0, 0.0), 3.2);
 
 /// Loads the default scene of a `.gltf` or `.glb` file.
 pub fn load(path: &Path) -> Result<Model> {
+    check_extensions(path)?;
     let (doc, buffers, images) = gltf::import(path).map_err(|e| Error::file(path, format!("cannot load the glTF: {e}")))?;
     from_document(path, doc, buffers, images)
+}
+
+/// Extensions a model may use that the loader cannot read, and what to do instead.
+const UNSUPPORTED: [(&str, &str); 2] = [
+    ("KHR_draco_mesh_compression", "decompress it first, e.g. `npx gltf-transform copy in.glb out.glb` or `gltf-pipeline -i in.glb -o out.glb`"),
+    ("EXT_meshopt_compression", "decompress it first, e.g. `npx gltf-transform copy in.glb out.glb`"),
+];
+
+/// Refuses, before loading, a model whose meshes use a compression this loader does not
+/// decode (naming the extension), rather than failing on the accessors it leaves empty.
+fn check_extensions(path: &Path) -> Result<()> {
+    let bytes = std::fs::read(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let Ok(doc) = gltf::Gltf::from_slice_without_validation(&bytes) else {
+        return Ok(()); // malformed: the loader's own error says how
+    };
+    for (ext, fix) in UNSUPPORTED {
+        if doc.extensions_used().chain(doc.extensions_required()).any(|e| e == ext) {
+            return Err(Error::file(path, format!("uses {ext} (compressed meshes), which splitsum does not decode; {fix}")));
+        }
+    }
+    Ok(())
 }
 
 fn from_document(path: &Path, doc: gltf::Document, buffers: Vec<gltf::buffer::Data>, images: Vec<gltf::image::Data>) -> Result<Model> {

@@ -165,8 +165,21 @@ pub struct Cost {
     pub gpu_seconds: f64,
     /// Seconds on 2 CPU cores.
     pub cpu_seconds: f64,
-    /// Bytes of the products in memory (f32 RGBA).
+    /// Bytes of the data in memory (the environment as read, the products and their sums).
     pub bytes: u64,
+}
+
+impl Cost {
+    /// Estimated peak resident memory of the process, in bytes: the data, plus the program
+    /// itself (8 MiB) on the CPU; on lavapipe the data twice (host copies and device
+    /// buffers, both in host memory) plus the driver (118 MiB). Measured with
+    /// `/usr/bin/time` on `runner lut --size 16` (the baselines) and `runner bake` of
+    /// courtyard.exr at its defaults: 57 MiB on the CPU, 227 MiB on lavapipe, against
+    /// 8 + 55 and 118 + 2·55 estimated.
+    pub fn peak_bytes(&self, gpu: bool) -> u64 {
+        const MIB: u64 = 1 << 20;
+        if gpu { 118 * MIB + 2 * self.bytes } else { 8 * MIB + self.bytes }
+    }
 }
 
 /// What to bake.
@@ -398,8 +411,13 @@ fn cheapest(table: &[(u32, f64)], target: f64, show: impl Fn(u32) -> String) -> 
     }
 }
 
-/// Estimated time and memory of baking `products` (and `levels` of the specular cube).
-pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration) -> Cost {
+/// The steps of a bake the cost model knows, in the order they run, with the index of
+/// their rate in [`Calibration::ns`].
+pub const STEPS: [&str; 4] = ["source cube", "specular", "brdf lut", "irradiance"];
+
+/// Units of work of each of [`STEPS`] (equirect supersamples, prefilter samples, BRDF
+/// table evaluations, irradiance texel pairs) and the bytes of the products in memory.
+fn work(s: &Settings, products: Products, levels: &[u32], width: u32) -> ([f64; 4], u64) {
     let mut work = [0.0f64; 4];
     let mut bytes = 0u64;
     let n = splitsum_shaders::equirect::supersampling(s.source_size, width.max(1), s.supersample_density) as f64;
@@ -423,7 +441,8 @@ pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, ca
                 };
                 work[1] += texels * per_texel;
             }
-            bytes += texels as u64 * 16;
+            // The sums (3 × RGBA per texel) and the result.
+            bytes += texels as u64 * 64;
         }
     }
     if products.lut {
@@ -432,15 +451,30 @@ pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, ca
             crate::bake::TableMethod::Sampled => s.lut_samples,
         };
         work[2] = (s.lut_size as f64).powi(2) * per_texel as f64;
-        bytes += (s.lut_size as u64).pow(2) * 8;
+        bytes += (s.lut_size as u64).pow(2) * 24;
     }
     if products.irradiance {
         work[3] = 6.0 * (s.irradiance_size as f64).powi(2) * 6.0 * (s.irradiance_source as f64).powi(2);
-        bytes += 6 * (s.irradiance_size as u64).pow(2) * 16;
+        bytes += 6 * (s.irradiance_size as u64).pow(2) * 64;
     }
-    let secs = |k: usize| -> (f64, f64) { (work[k] * cal.ns[k].0 * 1e-9, work[k] * cal.ns[k].1 * 1e-9) };
-    let total = (0..4).map(secs).fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
-    Cost { gpu_seconds: total.0, cpu_seconds: total.1, bytes }
+    (work, bytes)
+}
+
+/// Estimated seconds of each of [`STEPS`] that `products` run, on lavapipe (`gpu`) or on
+/// 2 CPU cores.
+pub fn step_seconds(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration, gpu: bool) -> [f64; 4] {
+    let (work, _) = work(s, products, levels, width);
+    std::array::from_fn(|k| work[k] * if gpu { cal.ns[k].0 } else { cal.ns[k].1 } * 1e-9)
+}
+
+/// Estimated time and memory of baking `products` (and `levels` of the specular cube)
+/// from an equirect `width` wide: the products and their sums, plus the environment as
+/// read (RGBA f32, with its row pyramid: `12·width²` bytes).
+pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration) -> Cost {
+    let (_, bytes) = work(s, products, levels, width);
+    let gpu = step_seconds(s, products, levels, width, cal, true).iter().sum();
+    let cpu = step_seconds(s, products, levels, width, cal, false).iter().sum();
+    Cost { gpu_seconds: gpu, cpu_seconds: cpu, bytes: bytes + 12 * (width as u64).pow(2) }
 }
 
 /// The plan as text, for `runner plan`.
@@ -467,8 +501,16 @@ pub fn describe(plan: &Plan, scene: &str, environment: &str) -> String {
         kept.push(format!("irradiance {}² from {}²", s.irradiance_size, s.irradiance_source));
     }
     let _ = writeln!(out, "  settings: {}", kept.join("; "));
-    let mib = |c: Cost| c.bytes as f64 / 1048576.0;
-    let line = |c: Cost| format!("{:.2} s on lavapipe, {:.2} s on 2 CPU cores, {:.1} MiB", c.gpu_seconds, c.cpu_seconds, mib(c));
+    let mib = |b: u64| b as f64 / 1048576.0;
+    let line = |c: Cost| {
+        format!(
+            "{:.2} s and {:.0} MiB on lavapipe, {:.2} s and {:.0} MiB on 2 CPU cores",
+            c.gpu_seconds,
+            mib(c.peak_bytes(true)),
+            c.cpu_seconds,
+            mib(c.peak_bytes(false))
+        )
+    };
     let _ = writeln!(out, "  estimate: {}", line(plan.cost));
     let _ = writeln!(out, "            every product and mip at these settings: {}", line(plan.full_cost));
     let _ = writeln!(out, "            `runner bake ENV` at its defaults:        {}", line(plan.default_cost));

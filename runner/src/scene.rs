@@ -502,6 +502,23 @@ impl Scene {
                 return bad(format!("[quality] max_error must be positive, not {e}"));
             }
         }
+        let q = &self.quality;
+        for (field, v) in [("samples", q.samples), ("lut_samples", q.lut_samples)] {
+            if v == Some(0) {
+                return bad(format!("[quality] {field} must be at least 1, not 0"));
+            }
+        }
+        if let Some(v) = q.lut_size.filter(|v| !(1..=crate::backend::MAX_LUT_SIZE).contains(v)) {
+            return bad(format!("[quality] lut_size must be from 1 to {}, not {v}", crate::backend::MAX_LUT_SIZE));
+        }
+        for (field, v, max) in [("size", q.size, crate::bake::MAX_SIZE), ("irradiance_source", q.irradiance_source, 256)] {
+            if let Some(v) = v.filter(|v| !v.is_power_of_two() || *v > max) {
+                return bad(format!("[quality] {field} must be a power of two from 1 to {max}, not {v}"));
+            }
+        }
+        if let Some(b) = q.lod_bias.filter(|b| !(b.is_finite() && (-16.0..=16.0).contains(b))) {
+            return bad(format!("[quality] lod_bias must be within ±16, not {b}"));
+        }
         Ok(())
     }
 

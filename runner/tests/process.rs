@@ -120,3 +120,113 @@ fn the_gpu_backend_takes_inputs_beyond_its_binding_limit() {
         assert!(worst < 1e-3, "mip {m}: worst relative difference {worst}");
     }
 }
+
+fn courtyard() -> String {
+    format!("{}/../assets/environments/courtyard.exr", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn listing(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir).map(|r| r.map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect()).unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The files `bake.json` of `dir` lists, itself included.
+fn manifest_files(dir: &Path) -> Vec<String> {
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("bake.json")).unwrap()).unwrap();
+    let mut v: Vec<String> = json["files"].as_array().unwrap().iter().map(|f| f["name"].as_str().unwrap().to_string()).collect();
+    v.push("bake.json".into());
+    v.sort();
+    v
+}
+
+/// SIGINT while reading, baking or writing: the output folder is afterwards the whole old
+/// set (byte for byte) or the whole new set (every file its manifest lists, nothing else),
+/// and its parent holds no staging folder.
+#[test]
+fn an_interrupted_bake_leaves_the_old_folder_or_the_whole_new_one() {
+    use std::io::BufRead;
+    for phase in ["reading", "specular…", "writing the files…"] {
+        let d = scratch(&format!("sigint-{}", phase.len()));
+        let out = d.join("out");
+        let o = runner().args(["bake", &courtyard(), "--backend", "cpu", "--size", "32", "--out", out.to_str().unwrap()]).output().unwrap();
+        assert!(o.status.success(), "{}", text(&o));
+        let old = listing(&out);
+        let old_manifest = std::fs::read(out.join("bake.json")).unwrap();
+        let mut child = runner()
+            .args(["bake", &courtyard(), "--backend", "cpu", "--size", "512", "--out", out.to_str().unwrap()])
+            .stderr(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let stderr = child.stderr.take().unwrap();
+        let mut seen = Vec::new();
+        let mut sent = false;
+        // Read stderr to its end (the child's last words included), signalling once.
+        for line in std::io::BufReader::new(stderr).lines() {
+            let line = line.unwrap();
+            if !sent && line.starts_with(phase) {
+                // SAFETY: signalling our own child.
+                unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+                sent = true;
+            }
+            seen.push(line);
+        }
+        let status = child.wait().unwrap();
+        let now = listing(&out);
+        if now == old && std::fs::read(out.join("bake.json")).unwrap() == old_manifest {
+            assert_eq!(status.code(), Some(130), "interrupted in {phase}: {seen:?}");
+        } else {
+            assert_eq!(now, manifest_files(&out), "interrupted in {phase}: a mix of files: {seen:?}");
+            assert!(now.iter().any(|n| n == "specular_mip5.exr"), "the new set (512², 7 mips): {now:?}");
+        }
+        assert_eq!(listing(&d), ["out"], "interrupted in {phase}: leftovers beside the output folder");
+    }
+}
+
+/// A full disk (a 2 MiB tmpfs, in a private mount namespace) fails the second, larger bake
+/// with the system's own words, and leaves the first bake's folder as it was and nothing
+/// else.
+#[test]
+fn a_full_disk_leaves_the_old_folder_as_it_was() {
+    let d = scratch("full");
+    let script = format!(
+        "set -u; mount -t tmpfs -o size=2m tmpfs {d} || exit 99; \
+         {r} bake {env} --backend cpu --size 16 --out {d}/out >/dev/null 2>&1 || exit 98; \
+         ls -A {d}/out > {d}/before.txt; md5sum {d}/out/bake.json > {d}/sum.txt; \
+         {r} bake {env} --backend cpu --size 256 --out {d}/out; echo rc=$?; \
+         echo parent:; ls -A {d}; echo out:; ls -A {d}/out | diff - {d}/before.txt && echo same-files; md5sum -c --quiet {d}/sum.txt && echo same-manifest",
+        d = d.display(),
+        r = env!("CARGO_BIN_EXE_runner"),
+        env = courtyard()
+    );
+    let o = Command::new("unshare").args(["--user", "--map-root-user", "--mount", "sh", "-c", &script]).output().expect("unshare (util-linux)");
+    let t = text(&o);
+    assert!(o.status.code() != Some(99) && o.status.code() != Some(98), "could not set up the tmpfs: {t}");
+    assert!(t.contains("No space left on device") && !t.contains("rc=0"), "{t}");
+    assert!(t.contains("parent:\nbefore.txt\nout\nsum.txt\nout:"), "leftovers beside the output folder: {t}");
+    assert!(t.contains("same-files") && t.contains("same-manifest"), "{t}");
+}
+
+/// Two `bake --scene` runs of one scene on one cache at once: one bakes, the other waits
+/// for it and takes its entry.
+#[test]
+fn concurrent_scene_bakes_bake_once() {
+    let d = scratch("concurrent");
+    let scene = format!("{}/../scenes/brushed-metal.toml", env!("CARGO_MANIFEST_DIR"));
+    let spawn = |name: &str| {
+        runner()
+            .args(["bake", "--scene", &scene, "--backend", "cpu", "--cache", d.join("cache").to_str().unwrap(), "--out", d.join(name).to_str().unwrap()])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (a, b) = (spawn("a"), spawn("b"));
+    let (a, b) = (a.wait_with_output().unwrap(), b.wait_with_output().unwrap());
+    let (ta, tb) = (text(&a), text(&b));
+    assert!(a.status.success() && b.status.success(), "{ta}\n{tb}");
+    let baked = [&ta, &tb].iter().filter(|t| t.contains("\nbaked ")).count();
+    let hits = [&ta, &tb].iter().filter(|t| t.contains("cache hit")).count();
+    assert_eq!((baked, hits), (1, 1), "{ta}\n{tb}");
+}

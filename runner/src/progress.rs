@@ -1,0 +1,67 @@
+//! Progress on stderr. Every step of a bake shows a spinner with its elapsed time and the
+//! planner's estimate (`plan::step_seconds`), and the CPU backend's long loops a bar under
+//! it; all are drawn by one `indicatif::MultiProgress`. Where stderr is not a terminal
+//! (CI logs, pipes), bars are hidden and each step prints one line as it starts instead.
+
+use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
+use std::sync::LazyLock;
+use std::time::Duration;
+
+static MULTI: LazyLock<MultiProgress> = LazyLock::new(MultiProgress::new);
+
+fn interactive() -> bool {
+    std::io::stderr().is_terminal()
+}
+
+/// A bar of `len` units named `what`.
+pub fn bar(what: &str, len: u64) -> ProgressBar {
+    let bar = MULTI.add(ProgressBar::new(len));
+    bar.set_style(
+        ProgressStyle::with_template("{prefix:>14} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})").expect("valid template").progress_chars("=> "),
+    );
+    bar.set_prefix(what.to_string());
+    bar
+}
+
+/// A step of a run, shown until dropped.
+pub struct Step(ProgressBar);
+
+/// Starts step `what`, estimated to take `estimate` seconds (if known).
+pub fn step(what: &str, estimate: Option<f64>) -> Step {
+    let est = match estimate {
+        Some(s) if s >= 0.05 => format!(" (estimate {})", seconds(s)),
+        _ => String::new(),
+    };
+    if !interactive() {
+        eprintln!("{what}…{est}");
+        return Step(ProgressBar::hidden());
+    }
+    let bar = MULTI.add(ProgressBar::new_spinner());
+    bar.set_style(ProgressStyle::with_template("{spinner} {prefix} {elapsed}{msg}").expect("valid template"));
+    bar.set_prefix(what.to_string());
+    bar.set_message(est);
+    bar.enable_steady_tick(Duration::from_millis(120));
+    Step(bar)
+}
+
+impl Drop for Step {
+    fn drop(&mut self) {
+        self.0.finish_and_clear();
+    }
+}
+
+/// `s` seconds in words: `0.4 s`, `12 s`, `3.2 min`, `5.1 h`, `12 days`.
+pub fn seconds(s: f64) -> String {
+    if s < 10.0 {
+        format!("{s:.1} s")
+    } else if s < 120.0 {
+        format!("{s:.0} s")
+    } else if s < 7200.0 {
+        format!("{:.1} min", s / 60.0)
+    } else if s < 172_800.0 {
+        format!("{:.1} h", s / 3600.0)
+    } else {
+        format!("{:.0} days", s / 86400.0)
+    }
+}
