@@ -599,7 +599,19 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         }
         println!("  {:<12} {:>9.3} s", "total", best.iter().map(|t| t.seconds).sum::<f64>());
     }
+    if let Some(peak) = peak_memory() {
+        println!("peak memory of this process (VmHWM, all backends so far): {:.0} MiB", peak as f64 / 1048576.0);
+    }
     Ok(())
+}
+
+/// The peak resident memory of this process in bytes, as the kernel counts it (`VmHWM` in
+/// `/proc/self/status`; Linux only).
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }
 
 /// Reads the environment at `path` for cubes of faces up to `face`

@@ -230,3 +230,19 @@ fn concurrent_scene_bakes_bake_once() {
     let hits = [&ta, &tb].iter().filter(|t| t.contains("cache hit")).count();
     assert_eq!((baked, hits), (1, 1), "{ta}\n{tb}");
 }
+
+/// `bench` reports the process's peak memory as the kernel counts it.
+#[test]
+fn bench_reports_peak_memory() {
+    let o = runner().args(["bench", &courtyard(), "--backends", "cpu", "--size", "32"]).output().unwrap();
+    assert!(o.status.success(), "{}", text(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let mib: f64 = out
+        .lines()
+        .find_map(|l| l.strip_prefix("peak memory of this process (VmHWM, all backends so far): "))
+        .and_then(|v| v.trim_end_matches(" MiB").parse().ok())
+        .unwrap_or_else(|| panic!("no peak memory line: {out}"));
+    // The embedded-size HDRI, decoded (8 MiB as RGBA f32) and baked at 32²: more than the
+    // image, far less than a gigabyte.
+    assert!((8.0..1024.0).contains(&mib), "{mib} MiB");
+}
