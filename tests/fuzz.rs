@@ -1,6 +1,6 @@
 //! A fuzzing budget for every loader: valid seeds mutated at random (bytes overwritten,
 //! files cut short) and random inputs, fed to the EXR, HDR, face-folder, glTF, scene,
-//! cache and KTX2 readers. Each must answer with a value or an error, never panic.
+//! cache and KTX2 readers, and Draco-compressed glTF. Each must answer with a value or an error, never panic.
 //! `PROPTEST_CASES` raises the budget (default 48 cases per loader, a few seconds here).
 
 use proptest::prelude::*;
@@ -91,6 +91,14 @@ proptest! {
         let d = scratch("gltf");
         let p = d.join("model.glb");
         std::fs::write(&p, mutate(runner::model::EMBEDDED_SAMPLE, &e.0, e.1)).unwrap();
+        let _ = runner::model::load(&p);
+    }
+
+    #[test]
+    fn draco_models(speed in prop_oneof![Just(0), Just(10)], e in edits()) {
+        let d = scratch("draco");
+        let p = d.join("model.glb");
+        std::fs::write(&p, mutate(&support::draco_torus_glb(speed), &e.0, e.1)).unwrap();
         let _ = runner::model::load(&p);
     }
 

@@ -118,15 +118,39 @@ pub const PLACE_BESIDE_GRID: (Vec3, f32) = (Vec3::new(5.4, 0.0, 0.0), 3.2);
 /// Loads the default scene of a `.gltf` or `.glb` file.
 pub fn load(path: &Path) -> Result<Model> {
     check_extensions(path)?;
-    let (doc, buffers, images) = gltf::import(path).map_err(|e| Error::file(path, format!("cannot load the glTF: {e}")))?;
-    from_document(path, doc, buffers, images)
+    let validated = gltf::import(path);
+    let (doc, buffers, images) = match validated {
+        Ok(imported) => imported,
+        // Draco primitives' accessors have no bufferView (their data is in the extension's),
+        // which the validator reports as missing data: read such a file unvalidated.
+        Err(_) if uses_draco(path) => import_unvalidated(path)?,
+        Err(e) => return Err(Error::file(path, format!("cannot load the glTF: {e}"))),
+    };
+    // An unvalidated document may index past its arrays, and the glTF crate panics there:
+    // turn that into an error about the file.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| from_document(path, doc, buffers, images)))
+        .unwrap_or_else(|_| Err(Error::file(path, "malformed glTF (an index points past its array)")))
+}
+
+/// The name of the Draco extension (Khronos, `KHR_draco_mesh_compression`).
+const DRACO: &str = "KHR_draco_mesh_compression";
+
+fn uses_draco(path: &Path) -> bool {
+    std::fs::read(path).ok().and_then(|b| gltf::Gltf::from_slice_without_validation(&b).ok()).is_some_and(|g| g.extensions_used().any(|e| e == DRACO))
+}
+
+fn import_unvalidated(path: &Path) -> Result<(gltf::Document, Vec<gltf::buffer::Data>, Vec<gltf::image::Data>)> {
+    let fail = |e: gltf::Error| Error::file(path, format!("cannot load the glTF: {e}"));
+    let bytes = std::fs::read(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(&bytes).map_err(fail)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(fail)?;
+    let images = gltf::import_images(&document, Some(base), &buffers).map_err(fail)?;
+    Ok((document, buffers, images))
 }
 
 /// Extensions a model may use that the loader cannot read, and what to do instead.
-const UNSUPPORTED: [(&str, &str); 2] = [
-    ("KHR_draco_mesh_compression", "decompress it first, e.g. `npx gltf-transform copy in.glb out.glb` or `gltf-pipeline -i in.glb -o out.glb`"),
-    ("EXT_meshopt_compression", "decompress it first, e.g. `npx gltf-transform copy in.glb out.glb`"),
-];
+const UNSUPPORTED: [(&str, &str); 1] = [("EXT_meshopt_compression", "decompress it first, e.g. `npx gltf-transform copy in.glb out.glb`")];
 
 /// Refuses, before loading, a model whose meshes use a compression this loader does not
 /// decode (naming the extension), rather than failing on the accessors it leaves empty.
@@ -147,7 +171,7 @@ fn from_document(path: &Path, doc: gltf::Document, buffers: Vec<gltf::buffer::Da
     let scene = doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| Error::file(path, "has no scene"))?;
     let mut primitives = Vec::new();
     for node in scene.nodes() {
-        visit(path, &node, Mat4::IDENTITY, &buffers, &images, &mut primitives)?;
+        visit(path, &doc, &node, Mat4::IDENTITY, &buffers, &images, &mut primitives)?;
     }
     if primitives.is_empty() {
         return Err(Error::file(path, "has no triangle meshes"));
@@ -155,45 +179,104 @@ fn from_document(path: &Path, doc: gltf::Document, buffers: Vec<gltf::buffer::Da
     Ok(Model { primitives })
 }
 
-fn visit(path: &Path, node: &gltf::Node, parent: Mat4, buffers: &[gltf::buffer::Data], images: &[gltf::image::Data], out: &mut Vec<Primitive>) -> Result<()> {
+fn visit(
+    path: &Path,
+    doc: &gltf::Document,
+    node: &gltf::Node,
+    parent: Mat4,
+    buffers: &[gltf::buffer::Data],
+    images: &[gltf::image::Data],
+    out: &mut Vec<Primitive>,
+) -> Result<()> {
     let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
     if let Some(mesh) = node.mesh() {
         for prim in mesh.primitives() {
             if prim.mode() != gltf::mesh::Mode::Triangles {
                 continue;
             }
-            out.push(primitive(path, &prim, world, buffers, images)?);
+            out.push(primitive(path, doc, &prim, world, buffers, images)?);
         }
     }
     for child in node.children() {
-        visit(path, &child, world, buffers, images, out)?;
+        visit(path, doc, &child, world, buffers, images, out)?;
     }
     Ok(())
 }
 
-fn primitive(path: &Path, prim: &gltf::Primitive, world: Mat4, buffers: &[gltf::buffer::Data], images: &[gltf::image::Data]) -> Result<Primitive> {
-    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
-    let positions: Vec<Vec3> = reader.read_positions().ok_or_else(|| Error::file(path, "a primitive has no POSITION"))?.map(Vec3::from).collect();
-    let n = positions.len();
-    let indices: Vec<u32> = match reader.read_indices() {
-        Some(i) => i.into_u32().collect(),
-        None => (0..n as u32).collect(),
+/// The vertex data of one primitive, as stored (accessors, or a Draco stream).
+struct Geometry {
+    positions: Vec<Vec3>,
+    indices: Option<Vec<u32>>,
+    uvs: Option<Vec<Vec2>>,
+    normals: Option<Vec<Vec3>>,
+    tangents: Option<Vec<Vec4>>,
+}
+
+/// Decodes a `KHR_draco_mesh_compression` primitive with `draco-core` (a pure-Rust Draco
+/// decoder): the extension names the buffer view holding the Draco stream and, per glTF
+/// attribute, the Draco attribute's unique id. Every attribute is read as f32 through the
+/// stream's point-to-value mapping, and the faces give the indices.
+fn draco_geometry(path: &Path, doc: &gltf::Document, ext: &serde_json::Value, buffers: &[gltf::buffer::Data]) -> Result<Geometry> {
+    let bad = |why: String| Error::file(path, format!("{DRACO}: {why}"));
+    let view_index = ext.get("bufferView").and_then(|v| v.as_u64()).ok_or_else(|| bad("no bufferView".into()))? as usize;
+    let view = doc.views().nth(view_index).ok_or_else(|| bad(format!("bufferView {view_index} does not exist")))?;
+    let buffer = buffers.get(view.buffer().index()).ok_or_else(|| bad("its buffer is missing".into()))?;
+    let bytes = buffer.0.get(view.offset()..view.offset() + view.length()).ok_or_else(|| bad("its bufferView runs past its buffer".into()))?;
+    let mut mesh = draco_core::Mesh::new();
+    draco_core::MeshDecoder::new().decode(&mut draco_core::DecoderBuffer::new(bytes), &mut mesh).map_err(|e| bad(format!("cannot decode the mesh: {e}")))?;
+    let points = mesh.num_points();
+    let read = |name: &str, components: usize| -> Result<Option<Vec<f32>>> {
+        let Some(id) = ext.get("attributes").and_then(|a| a.get(name)).and_then(|v| v.as_u64()) else { return Ok(None) };
+        let attribute = mesh.attribute_by_unique_id(id as u32).ok_or_else(|| bad(format!("{name} names attribute {id}, which the stream lacks")))?;
+        Ok(Some(attribute.read_f32s(points, components)))
     };
+    let positions = read("POSITION", 3)?.ok_or_else(|| bad("no POSITION".into()))?;
+    let indices = (0..mesh.num_faces()).flat_map(|f| mesh.face(draco_core::FaceIndex(f as u32)).map(|p| p.0)).collect();
+    Ok(Geometry {
+        positions: positions.chunks_exact(3).map(Vec3::from_slice).collect(),
+        indices: Some(indices),
+        uvs: read("TEXCOORD_0", 2)?.map(|v| v.chunks_exact(2).map(Vec2::from_slice).collect()),
+        normals: read("NORMAL", 3)?.map(|v| v.chunks_exact(3).map(Vec3::from_slice).collect()),
+        tangents: read("TANGENT", 4)?.map(|v| v.chunks_exact(4).map(Vec4::from_slice).collect()),
+    })
+}
+
+fn primitive(
+    path: &Path,
+    doc: &gltf::Document,
+    prim: &gltf::Primitive,
+    world: Mat4,
+    buffers: &[gltf::buffer::Data],
+    images: &[gltf::image::Data],
+) -> Result<Primitive> {
+    let g = match prim.extension_value(DRACO) {
+        Some(ext) => draco_geometry(path, doc, ext, buffers)?,
+        None => {
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            Geometry {
+                positions: reader.read_positions().ok_or_else(|| Error::file(path, "a primitive has no POSITION"))?.map(Vec3::from).collect(),
+                indices: reader.read_indices().map(|i| i.into_u32().collect()),
+                uvs: reader.read_tex_coords(0).map(|t| t.into_f32().map(Vec2::from).collect()),
+                normals: reader.read_normals().map(|ns| ns.map(Vec3::from).collect()),
+                tangents: reader.read_tangents().map(|ts| ts.map(Vec4::from).collect()),
+            }
+        }
+    };
+    let positions = g.positions;
+    let n = positions.len();
+    let indices: Vec<u32> = g.indices.unwrap_or_else(|| (0..n as u32).collect());
     if indices.iter().any(|&i| i as usize >= n) || indices.len() % 3 != 0 {
         return Err(Error::file(path, "a primitive has indices out of range or not a whole number of triangles"));
     }
-    let uvs: Vec<Vec2> = match reader.read_tex_coords(0) {
-        Some(t) => t.into_f32().map(Vec2::from).collect(),
-        None => vec![Vec2::ZERO; n],
+    let per_vertex = |name: &str, len: usize| -> Result<()> {
+        if len != n { Err(Error::file(path, format!("a primitive has {len} {name} for {n} positions"))) } else { Ok(()) }
     };
-    let normals: Vec<Vec3> = match reader.read_normals() {
-        Some(ns) => ns.map(Vec3::from).collect(),
-        None => face_normals(&positions, &indices),
-    };
-    let tangents: Vec<Vec4> = match reader.read_tangents() {
-        Some(ts) => ts.map(Vec4::from).collect(),
-        None => uv_tangents(&positions, &normals, &uvs, &indices),
-    };
+    let uvs: Vec<Vec2> = g.uvs.unwrap_or_else(|| vec![Vec2::ZERO; n]);
+    per_vertex("TEXCOORD_0", uvs.len())?;
+    let normals: Vec<Vec3> = g.normals.unwrap_or_else(|| face_normals(&positions, &indices));
+    per_vertex("NORMAL", normals.len())?;
+    let tangents: Vec<Vec4> = g.tangents.unwrap_or_else(|| uv_tangents(&positions, &normals, &uvs, &indices));
+    per_vertex("TANGENT", tangents.len())?;
     let normal_matrix = Mat3::from_mat4(world).inverse().transpose();
     let linear = Mat3::from_mat4(world);
     let flip = if linear.determinant() < 0.0 { -1.0 } else { 1.0 };
