@@ -105,3 +105,49 @@ fn compensated_sum_does_not_drift() {
     println!("2^24+1 × 0.1: compensated relative error {err:.2e}, naive {:.2e}", (naive as f64 - exact).abs() / exact);
     assert!(err < 1e-7, "{err:e}");
 }
+
+/// `math::floor` equals the f64 floor of the same value, bit for bit (signed zeros included), over every exponent and the edges.
+#[test]
+fn floor_is_exact_bit_for_bit() {
+    let mut values = vec![
+        0.0f32,
+        -0.0,
+        0.5,
+        -0.5,
+        1.0,
+        -1.0,
+        1.5,
+        -1.5,
+        f32::MIN_POSITIVE,
+        -f32::MIN_POSITIVE,
+        1e-45,
+        -1e-45,
+        f32::MAX,
+        f32::MIN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+    ];
+    for k in -3i32..=3 {
+        for base in [8_388_608.0f32, 16_777_216.0, 2_147_483_648.0] {
+            values.push(base + k as f32);
+            values.push(-(base + k as f32));
+        }
+    }
+    // Every exponent and sign, with pseudo-random mantissas.
+    let mut state = 0x2545_F491u32;
+    for _ in 0..2_000_000 {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        let v = f32::from_bits(state);
+        if !v.is_nan() {
+            values.push(v);
+        }
+    }
+    for v in values {
+        let want = (v as f64).floor() as f32;
+        let got = splitsum_shaders::math::floor(v);
+        assert_eq!(got.to_bits(), want.to_bits(), "floor({v:e}) = {got:e}, want {want:e}");
+    }
+    assert!(splitsum_shaders::math::floor(f32::NAN).is_nan());
+}
