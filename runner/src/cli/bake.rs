@@ -1,0 +1,120 @@
+//! `runner bake`: an environment, or a scene's plan, into an output folder.
+
+use super::*;
+use crate::bake;
+
+#[derive(Args)]
+pub(super) struct BakeArgs {
+    /// The environment: an equirectangular .hdr or .exr, or a folder holding six faces
+    /// px nx py ny pz nz (.hdr or .exr) in Vulkan/KTX2 orientation (or --scene).
+    #[arg(required_unless_present = "scene")]
+    env: Option<PathBuf>,
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output folder (created if missing).
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
+    #[command(flatten)]
+    quality: QualityArgs,
+    /// Where to bake.
+    #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
+    backend: BackendKind,
+    /// Replace NaN and -inf texels by 0 and +inf by the channel's largest finite value
+    /// instead of refusing the file.
+    #[arg(long)]
+    sanitize: bool,
+}
+
+pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
+    if let Some(scene_path) = &args.scene.scene {
+        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        refuse_beside_scene(given, &SCENE_FLAGS)?;
+        let out = files::OutputDir::begin(&args.out, "--out")?;
+        let backend = Backend::open(args.backend)?;
+        let (_, sb) = args.scene.bake(scene_path, &backend)?;
+        write_scene_bake(&out, &sb, &args.quality.format)?;
+        out.commit()?;
+        return Ok(());
+    }
+    let env_path = args.env.clone().expect("clap requires ENV without --scene");
+    let settings = args.quality.settings();
+    settings.validate()?;
+    let out = files::OutputDir::begin(&args.out, "--out")?;
+    let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
+    let backend = Backend::open(args.backend)?;
+    let all: Vec<u32> = (0..settings.mips).collect();
+    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, Products::ALL, &all), args.scene.force)?;
+    println!("baking {} on {}", env_path.display(), backend.describe());
+    let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
+    let manifest = bake::Manifest {
+        environment: env_path.display().to_string(),
+        backend: backend.describe(),
+        settings: settings.clone(),
+        roughness_per_mip: settings.roughness(),
+        samples_per_mip: settings.samples_per_mip(),
+        accuracy: bake::DEFAULTS_ACCURACY,
+        input: (&input).into(),
+        timings: Vec::new(),
+        sh9_vs_convolution: None,
+        files: Vec::new(),
+        conventions: bake::CONVENTIONS.to_vec(),
+    };
+    let manifest = bake::write(out.path(), &baked, &settings, manifest)?;
+    out.commit()?;
+    for t in &manifest.timings {
+        println!("  {:<12} {:>9.3} s", t.product, t.seconds);
+    }
+    println!("  {:<12} {:>9.3} s", "total", manifest.timings.iter().map(|t| t.seconds).sum::<f64>());
+    if let Some(e) = manifest.sh9_vs_convolution {
+        println!(
+            "  sh9.json (9 coefficients, a band-limited stand-in for irradiance.ktx2) against the convolution: max relative error {:.1} %, rms {:.1} % over the irradiance texels; small bright sources exceed what 9 coefficients hold, prefer irradiance.ktx2",
+            100.0 * e.max_relative,
+            100.0 * e.rms_relative
+        );
+    }
+    println!("wrote {} files to {}", manifest.files.len() + 1, args.out.display());
+    Ok(())
+}
+
+/// Writes a scene's bake: KTX2 of the products the plan kept, the table as EXR, and
+/// `plan.json` (decisions, settings, levels, cache key). `specular.ktx2` holds the baked
+/// mips `first ..= last` only (its mip 0 is level `first`; roughness per mip in
+/// `plan.json`; levels in between that the plan skips are zero).
+fn write_scene_bake(out: &files::OutputDir, sb: &bake::SceneBake, format: &Format) -> anyhow::Result<()> {
+    let dir = out.path();
+    let p = &sb.plan;
+    let mut written = Vec::new();
+    let all_roughness = p.settings.roughness();
+    let mut specular_roughness = Vec::new();
+    if let (true, Some(&first), Some(&last)) = (p.products.specular, p.levels.first(), p.levels.last()) {
+        crate::ktx2::write(&dir.join("specular.ktx2"), &sb.env.specular.levels(first, last), *format)?;
+        specular_roughness = (first..=last).map(|l| if p.levels.contains(&l) { Some(all_roughness[l as usize]) } else { None }).collect();
+        written.push("specular.ktx2");
+    }
+    if p.products.irradiance {
+        crate::ktx2::write(&dir.join("irradiance.ktx2"), &sb.env.irradiance, *format)?;
+        written.push("irradiance.ktx2");
+    }
+    if p.products.lut {
+        files::write_lut_exr(&dir.join("brdf_lut.exr"), &sb.env.lut)?;
+        written.push("brdf_lut.exr");
+    }
+    #[derive(serde::Serialize)]
+    struct PlanFile<'a> {
+        key: &'a str,
+        plan: &'a crate::plan::Plan,
+        /// Roughness of each mip of specular.ktx2 (null: skipped, zero).
+        specular_roughness_per_mip: Vec<Option<f32>>,
+        timings: &'a [bake::Timing],
+        files: &'a [&'a str],
+    }
+    let file = PlanFile { key: &sb.key, plan: p, specular_roughness_per_mip: specular_roughness, timings: &sb.timings, files: &written };
+    let json = serde_json::to_string_pretty(&file).expect("serialisable");
+    files::write_atomic(&dir.join("plan.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+    if written.is_empty() {
+        println!("the plan bakes nothing for this scene: wrote only plan.json (its decisions) to {}", out.target().display());
+    } else {
+        println!("wrote {} and plan.json to {}", written.join(", "), out.target().display());
+    }
+    Ok(())
+}

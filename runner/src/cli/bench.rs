@@ -1,0 +1,70 @@
+//! `runner bench`: bake time per product on each backend, and peak memory.
+
+use super::*;
+use crate::bake;
+
+#[derive(Args)]
+pub(super) struct BenchArgs {
+    /// The environment (as for `bake`).
+    env: PathBuf,
+    #[command(flatten)]
+    quality: QualityArgs,
+    /// Backends to time.
+    #[arg(long, value_enum, num_args = 1.., default_values_t = [BackendKind::Gpu, BackendKind::Cpu])]
+    backends: Vec<BackendKind>,
+    /// Runs per backend; the table shows the fastest.
+    #[arg(long, default_value_t = 1)]
+    runs: u32,
+    /// Run even if the bake is estimated to take over an hour.
+    #[arg(long)]
+    force: bool,
+}
+
+pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
+    let settings = args.quality.settings();
+    settings.validate()?;
+    let (env, _) = load_input(&args.env, false, settings.source_size)?;
+    println!(
+        "bench: {} at size {}, {} mips ({:?}), {:?} samples per mip, irradiance {}² from {}², SH9 from {}², table {}",
+        args.env.display(),
+        settings.size,
+        settings.mips,
+        settings.mapping,
+        settings.samples_per_mip(),
+        settings.irradiance_size,
+        settings.irradiance_source,
+        settings.sh_source,
+        settings.table_description()
+    );
+    for kind in &args.backends {
+        let backend = match Backend::open(*kind) {
+            Ok(b) => b,
+            Err(e) => {
+                println!("{kind:?}: skipped ({e})");
+                continue;
+            }
+        };
+        let all: Vec<u32> = (0..settings.mips).collect();
+        bake::check_duration(&bake::step_estimates(&backend, &env, &settings, Products::ALL, &all), args.force)?;
+        let mut best: Vec<bake::Timing> = Vec::new();
+        for _ in 0..args.runs.max(1) {
+            let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
+            if best.is_empty() {
+                best = baked.timings;
+            } else {
+                for (b, t) in best.iter_mut().zip(baked.timings) {
+                    b.seconds = b.seconds.min(t.seconds);
+                }
+            }
+        }
+        println!("{}", backend.describe());
+        for t in &best {
+            println!("  {:<12} {:>9.3} s", t.product, t.seconds);
+        }
+        println!("  {:<12} {:>9.3} s", "total", best.iter().map(|t| t.seconds).sum::<f64>());
+    }
+    if let Some(peak) = peak_memory() {
+        println!("peak memory of this process (VmHWM, all backends so far): {:.0} MiB", peak as f64 / 1048576.0);
+    }
+    Ok(())
+}

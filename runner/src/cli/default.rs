@@ -1,0 +1,67 @@
+//! `runner` with no arguments: the embedded environment on the sphere grid.
+
+use super::*;
+use crate::bake;
+
+/// `runner` with no arguments: bake the embedded environment and show the sphere grid in a
+/// window, or, where there is no display (or no GPU), render it to `splitsum.png`.
+pub(super) fn default_run() -> anyhow::Result<()> {
+    let (env, name) = load_environment(None, false)?;
+    let backend = match Backend::open(BackendKind::Gpu) {
+        Ok(b) => b,
+        Err(e) => {
+            eprintln!("{e}\nfalling back to the CPU backend");
+            Backend::Cpu
+        }
+    };
+    let display = DisplayBakeArgs { size: 128, samples: 256, sanitize: false };
+    let start = Instant::now();
+    let baked = bake::bake_for_display(&backend, &env, &display.settings(&env))?;
+    println!("baked {name} on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
+    let look = LookArgs {
+        diffuse: DiffuseArg::Lambert,
+        specular: SpecularArg::CookTorrance,
+        fresnel: FresnelArg::Schlick,
+        no_ibl: false,
+        no_lights: false,
+        exposure: 0.0,
+        tonemapper: TonemapArg::Aces,
+        sky_blur: 0.0,
+        yaw: 0.0,
+        pitch: 0.0,
+        model: None,
+        no_model: true,
+        no_grid: false,
+        shading: Default::default(),
+    };
+    let state = look.view(baked.auto_exposure());
+    let backend = match backend {
+        Backend::Gpu(gpu) if crate::view::display_available() => {
+            let options = crate::view::ViewOptions { size: (960, 540), ..Default::default() };
+            let gpu = *gpu;
+            match crate::view::run(gpu, &baked, None, state.clone(), options) {
+                Ok(()) => return Ok(()),
+                Err(e) => {
+                    eprintln!("{e}; rendering to a file instead");
+                    Backend::open(BackendKind::Gpu).unwrap_or(Backend::Cpu)
+                }
+            }
+        }
+        b => b,
+    };
+    let (w, h) = (960, 540);
+    let out = PathBuf::from("splitsum.png");
+    files::check_writable(&out)?;
+    let pixels = match &backend {
+        Backend::Gpu(g) => {
+            let scene = crate::render::GpuScene::new(g, &baked);
+            scene.render_offscreen(g, &state.frame(scene.shape, w, h, true), None)?
+        }
+        Backend::Cpu => crate::render::render_cpu(&baked, &state.frame(baked.shape(), w, h, true)),
+    };
+    files::write_png(&out, w, h, &crate::render::to_rgb8(&pixels))?;
+    let shown = std::fs::canonicalize(&out).unwrap_or(out);
+    println!("no display here: rendered the sphere grid ({w}×{h}) to {}", shown.display());
+    println!("{}", state.summary());
+    Ok(())
+}

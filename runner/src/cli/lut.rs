@@ -1,0 +1,65 @@
+//! `runner lut`: the split-sum BRDF table alone.
+
+use super::*;
+use crate::bake;
+
+#[derive(Args)]
+pub(super) struct LutArgs {
+    /// Table width and height: column x holds NdotV = (x+0.5)/S, row y roughness = (y+0.5)/S.
+    #[arg(long, default_value_t = 256)]
+    size: u32,
+    /// Deterministic quadrature (within 1e-5 of the f64 reference) or Hammersley sampling.
+    #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
+    method: TableMethod,
+    /// Masking–shadowing term: the exact height-correlated Smith or Smith–Schlick (k = α/2)
+    /// [default: correlated; schlick with --method sampled].
+    #[arg(long, value_enum)]
+    masking: Option<MaskingModel>,
+    /// Hammersley points per texel (with --method sampled).
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1024)]
+    samples: u32,
+    /// Where to bake.
+    #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
+    backend: BackendKind,
+    /// Output OpenEXR file (R = scale, G = bias, 32-bit float).
+    #[arg(long, default_value = "lut.exr")]
+    out: PathBuf,
+    /// Also write an 8-bit PNG preview beside it (same name, .png).
+    #[arg(long)]
+    png: bool,
+    /// Run even if the table is estimated to take over an hour.
+    #[arg(long)]
+    force: bool,
+}
+
+pub(super) fn lut(args: LutArgs) -> anyhow::Result<()> {
+    files::check_writable(&args.out)?;
+    let png = args.png.then(|| args.out.with_extension("png"));
+    if let Some(p) = &png {
+        files::check_writable(p)?;
+    }
+    let backend = Backend::open(args.backend)?;
+    let start = Instant::now();
+    let masking = args.masking.unwrap_or(args.method.default_masking());
+    let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: masking, ..Settings::default() };
+    if args.samples == 0 {
+        anyhow::bail!("--samples must be at least 1");
+    }
+    if settings.lut_method == TableMethod::Sampled && settings.lut_masking != MaskingModel::Schlick {
+        anyhow::bail!("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)");
+    }
+    let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };
+    let mut estimate = crate::plan::step_seconds(&settings, only_table, &[], 0, &crate::plan::Calibration::default(), matches!(backend, Backend::Gpu(_)));
+    estimate[0] = 0.0; // the cost model's source cube: a table needs none
+    bake::check_duration(&estimate, args.force).map_err(|e| anyhow::anyhow!(e.to_string().replace("--lut-size and --lut-samples", "--size and --samples")))?;
+    let lut = bake::brdf_table(&backend, &settings)?;
+    let secs = start.elapsed().as_secs_f64();
+    files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
+    println!("brdf lut {} on {}: bake {:.3} s", settings.table_description(), backend.describe(), secs);
+    println!("wrote {}", args.out.display());
+    if let Some(p) = png {
+        files::write_png(&p, lut.size, lut.size, &files::lut_preview(&lut))?;
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}

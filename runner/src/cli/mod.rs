@@ -1,0 +1,414 @@
+//! The command line: parsing with clap (derive), one module per subcommand; what they
+//! share (scene, quality and display flags, reading the environment) lives here.
+
+mod bake;
+mod bench;
+mod default;
+mod lut;
+mod plan;
+mod render;
+mod report;
+mod view;
+
+use crate::bake::{Mapping, MaskingModel, Products, Settings, TableMethod};
+use crate::environment;
+use crate::files;
+use crate::ktx2::Format;
+use crate::scene::{DiffuseArg, FresnelArg, SpecularArg, TonemapArg};
+use crate::{Backend, BackendKind};
+use anyhow::Context;
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(name = "runner", version, about = "splitsum: physically based image-based lighting, baked on the GPU with rust-gpu and checked on the CPU")]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Bake the split-sum BRDF integration table (scale and bias to F0) to a 2-channel EXR.
+    Lut(lut::LutArgs),
+    /// Bake an environment: prefiltered specular cube, irradiance cube and SH9, BRDF table.
+    Bake(bake::BakeArgs),
+    /// Time every product of a bake on each backend (a benchmark, not a test).
+    Bench(bench::BenchArgs),
+    /// Render the scene offscreen to a PNG (works without a display, on lavapipe or the CPU).
+    Render(render::RenderArgs),
+    /// Open the interactive viewer (needs a display; `runner render` does without).
+    View(view::ViewArgs),
+    /// Measure error against run time of every product on every backend (report.md,
+    /// report.csv, error_vs_time.png).
+    Report(report::ReportArgs),
+    /// Show what a scene needs baked and why, what is left out and why, and the cost.
+    Plan(plan::PlanArgs),
+}
+
+/// How a scene's bake is found or made.
+#[derive(Args, Clone)]
+pub struct SceneArgs {
+    /// A scene file (TOML): bake only what it needs, from the cache when unchanged. The
+    /// scene sets the environment, quality, camera, models, lights and output size.
+    #[arg(long)]
+    pub scene: Option<PathBuf>,
+    /// Bake again even if the cache holds this bake.
+    #[arg(long)]
+    pub force: bool,
+    /// The cache folder [default: $SPLITSUM_CACHE, $XDG_CACHE_HOME/splitsum or ~/.cache/splitsum].
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Error and cost measurements to plan with (a report.csv of `runner report`)
+    /// [default: built in].
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+}
+
+impl SceneArgs {
+    fn calibration(&self) -> anyhow::Result<crate::plan::Calibration> {
+        match &self.calibration {
+            None => Ok(crate::plan::Calibration::default()),
+            Some(p) => {
+                let text = std::fs::read_to_string(p).map_err(|e| crate::Error::file(p, format!("cannot read: {e}")))?;
+                crate::plan::Calibration::from_report_csv(&text)
+                    .ok_or_else(|| crate::Error::file(p, "is not a report.csv of `runner report` (no brdf lut, prefilter and irradiance rows)").into())
+            }
+        }
+    }
+
+    /// Loads the scene, plans it and bakes it (or takes it from the cache), saying which.
+    fn bake(&self, scene_path: &std::path::Path, backend: &Backend) -> anyhow::Result<(crate::scene::Scene, crate::bake::SceneBake)> {
+        let scene = crate::scene::Scene::load(scene_path)?;
+        let cache = crate::cache::Cache::new(self.cache.clone().unwrap_or_else(crate::cache::default_dir));
+        let start = Instant::now();
+        let sb = crate::bake::bake_scene(backend, &scene, &self.calibration()?, Some(&cache), self.force)?;
+        let short = &sb.key[..12];
+        match &sb.outcome {
+            crate::bake::Outcome::CacheHit => println!("cache hit {short}: nothing to bake ({})", cache.entry(&sb.key).display()),
+            crate::bake::Outcome::Baked => {
+                println!("baked {} on {} in {:.2} s; cached as {short}", scene_path.display(), backend.describe(), start.elapsed().as_secs_f64())
+            }
+            crate::bake::Outcome::Forced => println!("baked again (--force) in {:.2} s; cached as {short}", start.elapsed().as_secs_f64()),
+            crate::bake::Outcome::Rebuilt(why) => println!("cache entry {short} rejected ({why}); baked again in {:.2} s", start.elapsed().as_secs_f64()),
+        }
+        Ok((scene, sb))
+    }
+}
+
+/// What to look at and how.
+#[derive(Args, Clone)]
+pub struct LookArgs {
+    /// Diffuse model.
+    #[arg(long, value_enum, default_value_t = DiffuseArg::Lambert)]
+    pub diffuse: DiffuseArg,
+    /// Specular model.
+    #[arg(long, value_enum, default_value_t = SpecularArg::CookTorrance)]
+    pub specular: SpecularArg,
+    /// Fresnel form.
+    #[arg(long, value_enum, default_value_t = FresnelArg::Schlick)]
+    pub fresnel: FresnelArg,
+    /// Turn image-based lighting off.
+    #[arg(long)]
+    pub no_ibl: bool,
+    /// Turn the direct lights off.
+    #[arg(long)]
+    pub no_lights: bool,
+    /// Exposure in stops, added to the automatic exposure of the environment.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Tone curve.
+    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
+    pub tonemapper: TonemapArg,
+    /// Blur of the sky behind the scene, in specular mips (0 = sharp).
+    #[arg(long, default_value_t = 0.0)]
+    pub sky_blur: f32,
+    /// Camera orbit angle, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub yaw: f32,
+    /// Camera elevation, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub pitch: f32,
+    /// A glTF 2.0 model (.gltf or .glb) to show beside the spheres [default: the bundled
+    /// textured torus].
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Show no model.
+    #[arg(long, conflicts_with = "model")]
+    pub no_model: bool,
+    /// Hide the sphere grid.
+    #[arg(long)]
+    pub no_grid: bool,
+    #[command(flatten)]
+    pub shading: crate::scene::ShadingChoices,
+}
+
+impl LookArgs {
+    /// The view these flags describe, with `auto_exposure` from the environment.
+    pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
+        use splitsum_shaders::shade::ShadeOptions;
+        let flags = self.shading.flags(!self.no_ibl, !self.no_lights);
+        let mut view = crate::render::ViewState {
+            spheres: !self.no_grid,
+            show_model: !self.no_model,
+            yaw: self.yaw.to_radians(),
+            pitch: self.pitch.to_radians(),
+            exposure: auto_exposure * 2f32.powf(self.exposure),
+            tonemapper: self.tonemapper.curve(),
+            sky_blur: self.sky_blur,
+            options: ShadeOptions { diffuse: self.diffuse.code(), specular: self.specular.code(), fresnel: self.fresnel.code(), flags },
+            ..Default::default()
+        };
+        view.frame_contents();
+        view
+    }
+
+    /// The model to show, placed beside the grid (or centred without it), if any.
+    pub fn load_model(&self) -> anyhow::Result<Option<crate::model::Model>> {
+        if self.no_model {
+            return Ok(None);
+        }
+        let mut m = match &self.model {
+            Some(p) => crate::model::load(p)?,
+            None => crate::model::embedded_sample()?,
+        };
+        let (centre, size) = crate::model::PLACE_BESIDE_GRID;
+        m.fit(centre, size);
+        Ok(Some(m))
+    }
+}
+
+/// The display's bake: quicker defaults than `bake`, for an interactive start.
+#[derive(Args, Clone)]
+pub struct DisplayBakeArgs {
+    /// Face size of the specular cube.
+    #[arg(long, default_value_t = 128)]
+    pub size: u32,
+    /// GGX samples per specular texel.
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 256)]
+    pub samples: u32,
+    /// Replace NaN/inf texels instead of refusing the environment.
+    #[arg(long)]
+    pub sanitize: bool,
+}
+
+impl DisplayBakeArgs {
+    /// Bake settings for the display of `env`: the source cube as sharp as the environment
+    /// (a quarter of an equirect's width, up to 1024), the rest from the flags.
+    pub fn settings(&self, env: &environment::Environment) -> Settings {
+        let mips = Settings::default_mips(self.size);
+        let native = crate::plan::native_face_size(env);
+        Settings { size: self.size, source_size: native.max(self.size), mips, samples: self.samples, lut_size: 128, lut_samples: 512, ..Settings::default() }
+    }
+}
+
+/// The quality knobs of a bake.
+#[derive(Args, Clone)]
+pub struct QualityArgs {
+    /// Face size of mip 0 of the specular cube (a power of two).
+    #[arg(long, default_value_t = 256)]
+    pub size: u32,
+    /// Face size of the source cube the products are filtered from [default: --size].
+    #[arg(long)]
+    pub source_size: Option<u32>,
+    /// Specular mips, one roughness each [default: down to 8×8 faces].
+    #[arg(long)]
+    pub mips: Option<u32>,
+    /// How roughness is spread over the mips.
+    #[arg(long, value_enum, default_value_t = Mapping::Geometric)]
+    pub mapping: Mapping,
+    /// GGX samples per texel of specular mip 1 (the default, with --sample-growth 2, is the
+    /// best end-to-end error per millisecond measured by `runner report` on city.exr).
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 64)]
+    pub samples: u32,
+    /// Factor by which the sample count grows per mip after mip 1 (1 = the same on every mip).
+    #[arg(long, default_value_t = 2)]
+    pub sample_growth: u32,
+    /// Sample every mip, even the rough ones that an exact sum over a coarse source level
+    /// would bake for less.
+    #[arg(long)]
+    pub sampled_only: bool,
+    /// Bias added to the source mip each prefilter sample reads (0.5: the best error at 1024
+    /// samples in `runner report`, on city.exr's sun and on courtyard.exr).
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    pub lod_bias: f32,
+    /// Equirect → cube supersampling: points per source texel width.
+    #[arg(long, default_value_t = 2.0)]
+    pub supersample: f32,
+    /// Face size of the irradiance cube.
+    #[arg(long, default_value_t = 32)]
+    pub irradiance_size: u32,
+    /// Face size of the source mip the irradiance convolution sums over [default: 16, or
+    /// the source size if smaller].
+    #[arg(long)]
+    pub irradiance_source: Option<u32>,
+    /// Face size of the source mip projected onto SH9 (SH9's error is its band limit from
+    /// 16² up) [default: 32, or the source size if smaller].
+    #[arg(long)]
+    pub sh_source: Option<u32>,
+    /// Width and height of the BRDF table.
+    #[arg(long, default_value_t = 256)]
+    pub lut_size: u32,
+    /// Samples per texel of the BRDF table (with --lut-method sampled).
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1024)]
+    pub lut_samples: u32,
+    /// How the BRDF table is integrated: deterministic quadrature (within 1e-5) or sampling.
+    #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
+    pub lut_method: TableMethod,
+    /// The table's masking–shadowing term.
+    /// [default: correlated; schlick with --lut-method sampled]
+    #[arg(long, value_enum)]
+    pub lut_masking: Option<MaskingModel>,
+    /// KTX2 texel format; auto = RGBA16F unless a value exceeds 65504, then RGBA32F.
+    #[arg(long, value_enum, default_value_t = Format::Auto)]
+    pub format: Format,
+}
+
+impl QualityArgs {
+    /// The bake settings these flags describe.
+    pub fn settings(&self) -> Settings {
+        let mips = self.mips.unwrap_or_else(|| Settings::default_mips(self.size));
+        let source_size = self.source_size.unwrap_or(self.size);
+        let d = Settings::default();
+        Settings {
+            size: self.size,
+            source_size,
+            mips,
+            mapping: self.mapping,
+            samples: self.samples,
+            sample_growth: self.sample_growth,
+            exact_sums: !self.sampled_only,
+            lod_bias: self.lod_bias,
+            supersample_density: self.supersample,
+            irradiance_size: self.irradiance_size,
+            // Defaults that exceed a small source are fitted to it; given values are checked.
+            irradiance_source: self.irradiance_source.unwrap_or(d.irradiance_source.min(source_size)),
+            sh_source: self.sh_source.unwrap_or(d.sh_source.min(source_size)),
+            lut_size: self.lut_size,
+            lut_samples: self.lut_samples,
+            lut_method: self.lut_method,
+            lut_masking: self.lut_masking.unwrap_or(self.lut_method.default_masking()),
+            format: self.format,
+        }
+    }
+}
+
+/// With `--scene`, the scene file sets everything but where and how to run: refuses any
+/// other flag in `given`, naming them and the scene tables that set them.
+fn refuse_beside_scene(given: &[String], allowed: &[&str]) -> anyhow::Result<()> {
+    let extra: Vec<&str> = given.iter().map(String::as_str).filter(|f| !allowed.contains(f) && *f != "--scene" && *f != "--env").collect();
+    anyhow::ensure!(
+        extra.is_empty(),
+        "with --scene, the scene file sets the environment, [quality], [camera], [output] and the materials: drop {} (or edit the scene)",
+        extra.join(", ")
+    );
+    Ok(())
+}
+
+/// The flags that still apply beside `--scene`: where and how to run, and the cache.
+const SCENE_FLAGS: [&str; 6] = ["--force", "--cache", "--calibration", "--out", "--backend", "--format"];
+
+/// Parses `args` (the program name first) and runs the command.
+pub fn run<I, T>(args: I) -> anyhow::Result<()>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    use clap::{CommandFactory, FromArgMatches};
+    let matches = Cli::command().try_get_matches_from(args)?;
+    let cli = Cli::from_arg_matches(&matches)?;
+    // The flags written on the command line (not defaulted), as the user wrote them.
+    let given: Vec<String> = matches
+        .subcommand()
+        .map(|(name, sub)| {
+            let command = Cli::command();
+            let args: Vec<String> = command
+                .find_subcommand(name)
+                .map(|c| c.get_arguments().filter_map(|a| a.get_long().map(|l| (a.get_id().to_string(), l))).map(|(id, _)| id).collect())
+                .unwrap_or_default();
+            sub.ids()
+                .filter(|id| args.iter().any(|a| a == id.as_str()))
+                .filter(|id| sub.value_source(id.as_str()) == Some(clap::parser::ValueSource::CommandLine))
+                .map(|id| format!("--{}", id.as_str().replace('_', "-")))
+                .collect()
+        })
+        .unwrap_or_default();
+    match cli.command {
+        Some(Command::Lut(args)) => lut::lut(args),
+        Some(Command::Bake(args)) => bake::bake_command(args, &given),
+        Some(Command::Bench(args)) => bench::bench(args),
+        Some(Command::Render(args)) => render::render(args, &given),
+        Some(Command::View(args)) => view::view(args, &given),
+        Some(Command::Report(args)) => report::report(args),
+        Some(Command::Plan(args)) => plan::plan_command(args),
+        None => default::default_run(),
+    }
+}
+
+/// The peak resident memory of this process in bytes, as the kernel counts it (`VmHWM` in
+/// `/proc/self/status`; Linux only).
+fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+/// Reads the environment at `path` for cubes of faces up to `face`
+/// (`environment::load_for`), saying on stderr what reading it changed.
+pub fn load_input(path: &std::path::Path, sanitize: bool, face: u32) -> anyhow::Result<(environment::Environment, environment::InputReport)> {
+    let (env, input) = {
+        let _step = crate::progress::step(&format!("reading {}", path.display()), None);
+        environment::load_for(path, sanitize, face)?
+    };
+    let p = path.display();
+    if input.negative > 0 {
+        eprintln!("note: {p}: {} texels had negative values, set to 0", input.negative);
+    }
+    if input.clamped > 0 {
+        eprintln!("note: {p}: {} texels were brighter than 1e20 and were clamped to it", input.clamped);
+    }
+    if input.sanitized && (input.nan > 0 || input.infinite > 0) {
+        eprintln!("note: {p}: replaced {} NaN and {} infinite texels (--sanitize)", input.nan, input.infinite);
+    }
+    let (w, h) = input.original;
+    match &env {
+        environment::Environment::Equirect(e) if e.width < w => {
+            eprintln!("note: {p}: {w}×{h} read as {}×{} (area-weighted): a cube of {face}² faces resolves no more (--source-size)", e.width, e.height)
+        }
+        environment::Environment::Cube(c) if c.layout.size < w => {
+            eprintln!("note: {p}: faces of {w}² read as {}² (the cube's own mip filter): the bake uses no more (--source-size)", c.layout.size)
+        }
+        _ => {}
+    }
+    Ok((env, input))
+}
+
+/// The environment at `path` (for the display and the planner: cubes up to
+/// `environment::NATIVE_FACE`), or the embedded default.
+pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyhow::Result<(environment::Environment, String)> {
+    match path {
+        Some(p) => Ok((load_input(p, sanitize, environment::NATIVE_FACE)?.0, p.display().to_string())),
+        None => Ok((environment::embedded_default()?, "the embedded courtyard (CC0)".to_string())),
+    }
+}
+
+/// Renders `frame` (with `model`, if any) on `backend`: the GPU renderer, or the CPU
+/// reference renderer.
+fn render_frame(
+    backend: &Backend,
+    env: &crate::render::BakedEnvironment,
+    frame: &splitsum_shaders::scene::Frame,
+    model: Option<&crate::model::Model>,
+) -> anyhow::Result<Vec<splitsum_shaders::glam::Vec4>> {
+    Ok(match (backend, model) {
+        (Backend::Gpu(g), m) => {
+            let scene = crate::render::GpuScene::new(g, env);
+            let gm = m.map(|m| crate::render::GpuModel::new(g, &scene, m));
+            scene.render_offscreen(g, frame, gm.as_ref())?
+        }
+        (Backend::Cpu, Some(m)) => crate::raster::render(env, frame, m),
+        (Backend::Cpu, None) => crate::render::render_cpu(env, frame),
+    })
+}

@@ -1,0 +1,67 @@
+//! `runner render`: one frame offscreen, on the GPU or the CPU reference renderer.
+
+use super::*;
+use crate::bake;
+
+#[derive(Args)]
+pub(super) struct RenderArgs {
+    /// The environment (equirect .hdr/.exr or a six-face folder) [default: the embedded courtyard].
+    env: Option<PathBuf>,
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output image: .png, or .jpg (JPEG, quality 95).
+    #[arg(long, default_value = "frame.png")]
+    out: PathBuf,
+    /// Width in pixels.
+    #[arg(long, default_value_t = 960)]
+    width: u32,
+    /// Height in pixels.
+    #[arg(long, default_value_t = 540)]
+    height: u32,
+    /// Bake and render on the GPU, or bake and render on the CPU (the reference renderer).
+    #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
+    backend: BackendKind,
+    #[command(flatten)]
+    look: LookArgs,
+    #[command(flatten)]
+    bake: DisplayBakeArgs,
+}
+
+pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
+    let format = files::picture_format(&args.out, "--out")?;
+    files::check_writable(&args.out)?;
+    if let Some(scene_path) = &args.scene.scene {
+        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        refuse_beside_scene(given, &SCENE_FLAGS)?;
+        let backend = Backend::open(args.backend)?;
+        let (scene, sb) = args.scene.bake(scene_path, &backend)?;
+        let view = scene.view(sb.env.auto_exposure());
+        let model = scene.model()?;
+        let (w, h) = (scene.output.width, scene.output.height);
+        let start = Instant::now();
+        let pixels = render_frame(&backend, &sb.env, &view.frame(sb.env.shape(), w, h, true), model.as_ref())?;
+        files::write_rgb8(&args.out, w, h, &crate::render::to_rgb8(&pixels), format)?;
+        println!("rendered {w}×{h} in {:.3} s: {}", start.elapsed().as_secs_f64(), view.summary());
+        println!("wrote {}", args.out.display());
+        return Ok(());
+    }
+    crate::render::check_size(args.width, args.height)?;
+    let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
+    let backend = Backend::open(args.backend)?;
+    let settings = args.bake.settings(&env);
+    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &(0..settings.mips).collect::<Vec<_>>()), args.scene.force)?;
+    let start = Instant::now();
+    let baked = bake::bake_for_display(&backend, &env, &settings)?;
+    let bake_secs = start.elapsed().as_secs_f64();
+    let view = args.look.view(baked.auto_exposure());
+    let model = args.look.load_model()?;
+    let start = Instant::now();
+    let frame = view.frame(baked.shape(), args.width, args.height, true);
+    let pixels = render_frame(&backend, &baked, &frame, model.as_ref())?;
+    let render_secs = start.elapsed().as_secs_f64();
+    files::write_rgb8(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels), format)?;
+    println!("{name} on {}: bake {bake_secs:.2} s, render {render_secs:.3} s", backend.describe());
+    println!("{}", view.summary());
+    println!("wrote {}", args.out.display());
+    Ok(())
+}

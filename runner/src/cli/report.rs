@@ -1,0 +1,41 @@
+//! `runner report`: error against run time of every product and of the shaded colour.
+
+use super::*;
+
+#[derive(Args)]
+pub(super) struct ReportArgs {
+    /// The environment [default: the embedded courtyard].
+    env: Option<PathBuf>,
+    /// Output folder.
+    #[arg(long, default_value = "report")]
+    out: PathBuf,
+    /// Smaller sweeps that finish in seconds (CI).
+    #[arg(long)]
+    quick: bool,
+    /// Backends to measure (those that cannot be opened are skipped, with a note).
+    #[arg(long, value_enum, num_args = 1.., default_values_t = [BackendKind::Gpu, BackendKind::Cpu])]
+    backends: Vec<BackendKind>,
+}
+
+pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
+    let (env, name) = load_environment(args.env.as_deref(), false)?;
+    let mut backends = Vec::new();
+    for kind in &args.backends {
+        match Backend::open(*kind) {
+            Ok(b) => backends.push(b),
+            Err(e) => eprintln!("{kind:?}: skipped ({e})"),
+        }
+    }
+    anyhow::ensure!(!backends.is_empty(), "no backend could be opened");
+    let sweep = if args.quick { crate::report::Sweep::quick() } else { crate::report::Sweep::full() };
+    let start = Instant::now();
+    let out = files::OutputDir::begin(&args.out, "--out")?;
+    let rows = crate::report::run(&env, &name, &backends, &sweep, out.path())?;
+    out.commit()?;
+    println!("{} measurements in {:.1} s", rows.len(), start.elapsed().as_secs_f64());
+    for r in crate::report::best_per_ms(&rows) {
+        println!("  best error per ms: {:<28} {:<8} {:<24} {:>9.1} ms  mean error {:.2e}", r.product, &r.backend[..3], r.setting, r.time_ms, r.mean_error);
+    }
+    println!("wrote {}/report.md, report.csv, error_vs_time.png", args.out.display());
+    Ok(())
+}

@@ -1,0 +1,68 @@
+//! `runner view`: the interactive viewer.
+
+use super::*;
+use crate::bake;
+
+#[derive(Args)]
+pub(super) struct ViewArgs {
+    /// The environment (equirect .hdr/.exr or a six-face folder) [default: the embedded courtyard].
+    env: Option<PathBuf>,
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Window width.
+    #[arg(long, default_value_t = 960)]
+    width: u32,
+    /// Window height.
+    #[arg(long, default_value_t = 540)]
+    height: u32,
+    /// Close the window after this many seconds.
+    #[arg(long)]
+    exit_after: Option<f64>,
+    #[command(flatten)]
+    look: LookArgs,
+    #[command(flatten)]
+    bake: DisplayBakeArgs,
+}
+
+pub(super) fn view(args: ViewArgs, given: &[String]) -> anyhow::Result<()> {
+    if args.scene.scene.is_some() {
+        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        refuse_beside_scene(given, &["--force", "--cache", "--calibration", "--exit-after"])?;
+    }
+    if !crate::view::display_available() {
+        anyhow::bail!("no display (neither DISPLAY nor WAYLAND_DISPLAY is set); `runner render --out frame.png` renders without one");
+    }
+    if let Some(scene_path) = &args.scene.scene {
+        let backend = Backend::open(BackendKind::Gpu)?;
+        let (scene, sb) = args.scene.bake(scene_path, &backend)?;
+        let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
+        let state = scene.view(sb.env.auto_exposure());
+        let model = scene.model()?;
+        let options = crate::view::ViewOptions {
+            exit_after: args.exit_after.map(std::time::Duration::from_secs_f64),
+            size: (scene.output.width, scene.output.height),
+            ..Default::default()
+        };
+        crate::view::run(*gpu, &sb.env, model.as_ref(), state, options)?;
+        return Ok(());
+    }
+    crate::render::check_size(args.width, args.height)?;
+    let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
+    let backend = Backend::open(BackendKind::Gpu)?;
+    let settings = args.bake.settings(&env);
+    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &(0..settings.mips).collect::<Vec<_>>()), args.scene.force)?;
+    let start = Instant::now();
+    let baked = bake::bake_for_display(&backend, &env, &settings)?;
+    println!("{name} baked on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
+    let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
+    let state = args.look.view(baked.auto_exposure());
+    let model = args.look.load_model()?;
+    let options = crate::view::ViewOptions {
+        exit_after: args.exit_after.map(std::time::Duration::from_secs_f64),
+        exit_after_frames: None,
+        on_presented: None,
+        size: (args.width, args.height),
+    };
+    crate::view::run(*gpu, &baked, model.as_ref(), state, options)?;
+    Ok(())
+}
