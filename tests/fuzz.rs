@@ -98,7 +98,7 @@ proptest! {
     fn draco_models(speed in prop_oneof![Just(0), Just(10)], e in edits()) {
         let d = scratch("draco");
         let p = d.join("model.glb");
-        std::fs::write(&p, mutate(&support::draco_torus_glb(speed), &e.0, e.1)).unwrap();
+        std::fs::write(&p, mutate(&support::model::draco_torus_glb(speed), &e.0, e.1)).unwrap();
         let _ = runner::model::load(&p);
     }
 

@@ -127,7 +127,7 @@ fn draco_compressed_models_decode_to_their_geometry() {
         })
         .collect();
     for speed in [0, 10] {
-        let glb = support::draco_torus_glb(speed);
+        let glb = support::model::draco_torus_glb(speed);
         let dir = std::env::temp_dir().join(format!("splitsum-draco-{}-{speed}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("torus-draco.glb");

@@ -165,7 +165,13 @@ pub fn sample_glb() -> Vec<u8> {
         "bufferViews": views,
         "buffers": [{"byteLength": bin.len()}]
     });
-    let mut text = serde_json::to_vec(&json).unwrap();
+    glb(&json, &bin)
+}
+
+/// A binary glTF: the JSON chunk (padded with spaces) and the BIN chunk (`bin`, already
+/// padded to 4 bytes), after the 12-byte header.
+pub fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
+    let mut text = serde_json::to_vec(json).unwrap();
     while text.len() % 4 != 0 {
         text.push(b' ');
     }
@@ -178,6 +184,85 @@ pub fn sample_glb() -> Vec<u8> {
     glb.extend_from_slice(&text);
     glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
     glb.extend_from_slice(b"BIN\0");
-    glb.extend_from_slice(&bin);
+    glb.extend_from_slice(bin);
     glb
+}
+
+/// A GLB holding one Draco-compressed primitive (`KHR_draco_mesh_compression`): `stream`
+/// in buffer view 0, attributes by Draco unique id, `count` points and `faces` triangles.
+pub fn draco_glb(stream: &[u8], ids: [(&str, u32, &str); 3], count: usize, faces: usize) -> Vec<u8> {
+    let mut attributes = serde_json::Map::new();
+    let mut draco = serde_json::Map::new();
+    let mut accessors = Vec::new();
+    for (k, (name, id, kind)) in ids.iter().enumerate() {
+        attributes.insert(name.to_string(), serde_json::json!(k));
+        draco.insert(name.to_string(), serde_json::json!(id));
+        accessors.push(serde_json::json!({"componentType": 5126, "count": count, "type": kind}));
+    }
+    accessors.push(serde_json::json!({"componentType": 5125, "count": 3 * faces, "type": "SCALAR"}));
+    let mut bin = stream.to_vec();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    let json = serde_json::json!({
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_draco_mesh_compression"],
+        "extensionsRequired": ["KHR_draco_mesh_compression"],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": stream.len()}],
+        "accessors": accessors,
+        "meshes": [{"primitives": [{"attributes": attributes, "indices": 3, "mode": 4,
+            "extensions": {"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": draco}}}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0
+    });
+    glb(&json, &bin)
+}
+
+/// The embedded torus's first primitive (positions, normals, UVs; no node transform)
+/// compressed with `draco-core`'s encoder at `speed` (0: EdgeBreaker, which reorders
+/// vertices and faces; 10: sequential), with 14-bit positions, 10-bit normals and 12-bit
+/// UVs, as a `KHR_draco_mesh_compression` GLB.
+pub fn draco_torus_glb(speed: i32) -> Vec<u8> {
+    use draco_core::{DataType, EncoderBuffer, EncoderOptions, FaceIndex, GeometryAttributeType, Mesh, MeshEncoder, PointAttribute};
+    let (doc, buffers, _) = gltf::import_slice(runner::model::EMBEDDED_SAMPLE).unwrap();
+    let prim = doc.meshes().next().unwrap().primitives().next().unwrap();
+    let r = prim.reader(|b| Some(&buffers[b.index()].0[..]));
+    let positions: Vec<[f32; 3]> = r.read_positions().unwrap().collect();
+    let normals: Vec<[f32; 3]> = r.read_normals().unwrap().collect();
+    let uvs: Vec<[f32; 2]> = r.read_tex_coords(0).unwrap().into_f32().collect();
+    let indices: Vec<u32> = r.read_indices().unwrap().into_u32().collect();
+    let n = positions.len();
+    let attribute = |kind, comps: u8, values: Vec<f32>| {
+        let mut a = PointAttribute::new();
+        a.init(kind, comps, DataType::Float32, false, n);
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        a.buffer_mut().write(0, &bytes);
+        a
+    };
+    let mut mesh = Mesh::new();
+    mesh.set_num_points(n);
+    let ids = [
+        mesh.add_attribute(attribute(GeometryAttributeType::Position, 3, positions.concat())),
+        mesh.add_attribute(attribute(GeometryAttributeType::Normal, 3, normals.concat())),
+        mesh.add_attribute(attribute(GeometryAttributeType::TexCoord, 2, uvs.concat())),
+    ];
+    let faces = indices.len() / 3;
+    mesh.set_num_faces(faces);
+    for f in 0..faces {
+        mesh.set_face(FaceIndex(f as u32), [indices[3 * f].into(), indices[3 * f + 1].into(), indices[3 * f + 2].into()]);
+    }
+    let mut options = EncoderOptions::new();
+    options.set_global_int("encoding_speed", speed);
+    options.set_global_int("decoding_speed", speed);
+    options.set_attribute_int(0, "quantization_bits", 14);
+    options.set_attribute_int(1, "quantization_bits", 10);
+    options.set_attribute_int(2, "quantization_bits", 12);
+    let mut encoder = MeshEncoder::new();
+    encoder.set_mesh(mesh.clone());
+    let mut stream = EncoderBuffer::new();
+    encoder.encode(&options, &mut stream).unwrap();
+    let uid = |k: usize| mesh.attribute(ids[k]).unique_id();
+    draco_glb(stream.data(), [("POSITION", uid(0), "VEC3"), ("NORMAL", uid(1), "VEC3"), ("TEXCOORD_0", uid(2), "VEC2")], n, faces)
 }
