@@ -19,6 +19,8 @@ use std::path::{Path, PathBuf};
 
 /// Largest image side accepted (a 32768×16384 RGBA f32 equirect is 8 GiB).
 pub const MAX_SIDE: u32 = 32768;
+/// Largest cube face accepted (a face is read whole before it is reduced: 1 GiB at 8192²).
+pub const MAX_FACE: u32 = 8192;
 /// Smallest equirect accepted.
 pub const MIN_WIDTH: u32 = 8;
 
@@ -117,6 +119,15 @@ pub fn load_faces(paths: &[PathBuf; 6], sanitize: bool, face: u32) -> Result<(En
         if w != h {
             return Err(Error::file(p, format!("a cube face must be square, this one is {w}×{h}")));
         }
+        if w > MAX_FACE {
+            return Err(Error::file(
+                p,
+                format!(
+                    "a cube face may be at most {MAX_FACE}² (each face is read whole, {} MiB at that size), this one is {w}²",
+                    (MAX_FACE as u64).pow(2) * 16 >> 20
+                ),
+            ));
+        }
         if !w.is_power_of_two() {
             return Err(Error::file(p, format!("a cube face must be a power of two wide, this one is {w}")));
         }
@@ -183,11 +194,7 @@ pub fn dimensions(path: &Path) -> Result<(u32, u32)> {
             let size = header.layer_size;
             (size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32)
         }
-        Kind::Hdr => {
-            use image::ImageDecoder;
-            let decoder = image::codecs::hdr::HdrDecoder::new(buffered(path)?).map_err(|e| Error::file(path, format!("malformed Radiance HDR: {e}")))?;
-            decoder.dimensions()
-        }
+        Kind::Hdr => rgbe::header(path, &mut buffered(path)?)?,
     };
     check_side(path, w, h)?;
     Ok((w, h))
@@ -206,20 +213,150 @@ pub fn read_reduced(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirec
     }
 }
 
+/// A Radiance `.hdr` file, decoded scanline by scanline into a [`Reducer`] ([`rgbe`]).
 fn read_hdr(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
-    use image::ImageDecoder;
-    let decoder = image::codecs::hdr::HdrDecoder::new(buffered(path)?).map_err(|e| Error::file(path, format!("malformed Radiance HDR: {e}")))?;
-    let (w, h) = decoder.dimensions();
+    let mut r = buffered(path)?;
+    let (w, h) = rgbe::header(path, &mut r)?;
     check_side(path, w, h)?;
-    let mut reducer = Reducer::new(w, h, factor, sanitize);
-    let mut buf = vec![0u8; decoder.total_bytes() as usize];
-    decoder.read_image(&mut buf).map_err(|e| Error::file(path, format!("truncated or malformed Radiance HDR: {e}")))?;
-    for (i, c) in buf.chunks_exact(12).enumerate() {
-        let v: [f32; 3] = bytemuck::pod_read_unaligned(c);
-        reducer.push(i as u32 % w, i as u32 / w, v);
+    // Every scanline takes at least 4 bytes: refuse a header that promises more rows than
+    // the file can hold before allocating for them.
+    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    if len < 4 * h as u64 {
+        return Err(Error::file(path, format!("truncated Radiance HDR: {len} bytes cannot hold {h} scanlines")));
     }
-    drop(buf);
+    let mut reducer = Reducer::new(w, h, factor, sanitize);
+    let mut line = vec![[0u8; 4]; w as usize];
+    for y in 0..h {
+        rgbe::scanline(&mut r, &mut line).map_err(|e| Error::file(path, format!("truncated or malformed Radiance HDR (row {y}): {e}")))?;
+        for (x, p) in line.iter().enumerate() {
+            reducer.push(x as u32, y, rgbe::to_f32(*p));
+        }
+    }
     reducer.finish(path)
+}
+
+/// Radiance RGBE (Ward, "Real Pixels", Graphics Gems II, 1991; the format of `.hdr`
+/// files), read one scanline at a time, so a 16384×8192 file needs 64 KiB rather than the
+/// 1.5 GiB the `image` crate's whole-image decoder allocates (it has no row interface).
+/// The same rules as `image`'s decoder: a header up to an empty line, the standard
+/// orientation `-Y H +X W`, and per scanline either the adaptive run-length coding (a
+/// `2 2 hi lo` marker, then each component in runs) or flat/old-RLE pixels (`1 1 1 n`
+/// repeats the previous pixel). Values convert as `image` does: `c·2^(e−136)`.
+mod rgbe {
+    use crate::error::{Error, Result};
+    use std::io::{BufRead, Read};
+    use std::path::Path;
+
+    /// Reads the header and the resolution line: `(width, height)`.
+    pub fn header(path: &Path, r: &mut impl BufRead) -> Result<(u32, u32)> {
+        let bad = |why: String| Error::file(path, format!("malformed Radiance HDR: {why}"));
+        let mut line = String::new();
+        let mut first = true;
+        loop {
+            line.clear();
+            let n = r.by_ref().take(4096).read_line(&mut line).map_err(|e| bad(e.to_string()))?;
+            if n == 0 {
+                return Err(bad("the header never ends (no empty line)".into()));
+            }
+            let l = line.trim_end_matches(['\n', '\r']);
+            if first && !l.starts_with("#?") {
+                return Err(bad("no #? signature".into()));
+            }
+            first = false;
+            if let Some(format) = l.strip_prefix("FORMAT=") {
+                if format.trim() != "32-bit_rle_rgbe" {
+                    return Err(bad(format!("FORMAT={format} is not supported (only 32-bit_rle_rgbe)")));
+                }
+            }
+            if l.is_empty() {
+                break;
+            }
+        }
+        line.clear();
+        r.by_ref().take(256).read_line(&mut line).map_err(|e| bad(e.to_string()))?;
+        let f: Vec<&str> = line.split_whitespace().collect();
+        match f.as_slice() {
+            ["-Y", h, "+X", w] => match (h.parse::<u32>(), w.parse::<u32>()) {
+                (Ok(h), Ok(w)) => Ok((w, h)),
+                _ => Err(bad(format!("unreadable resolution line {:?}", line.trim_end()))),
+            },
+            _ => Err(bad(format!("resolution line {:?}: only the standard orientation -Y H +X W is supported", line.trim_end()))),
+        }
+    }
+
+    fn byte(r: &mut impl Read) -> std::io::Result<u8> {
+        let mut b = [0u8];
+        r.read_exact(&mut b)?;
+        Ok(b[0])
+    }
+
+    /// Decodes one scanline of `line.len()` pixels.
+    pub fn scanline(r: &mut impl Read, line: &mut [[u8; 4]]) -> std::io::Result<()> {
+        let width = line.len();
+        let mut first = [0u8; 4];
+        r.read_exact(&mut first)?;
+        let invalid = |why: &str| std::io::Error::new(std::io::ErrorKind::InvalidData, why.to_string());
+        if first[0] == 2 && first[1] == 2 && first[2] < 128 {
+            for c in 0..4 {
+                let mut x = 0;
+                while x < width {
+                    let n = byte(r)? as usize;
+                    if n > 128 {
+                        let run = n - 128;
+                        if x + run > width {
+                            return Err(invalid("a run passes the end of the scanline"));
+                        }
+                        let v = byte(r)?;
+                        line[x..x + run].iter_mut().for_each(|p| p[c] = v);
+                        x += run;
+                    } else {
+                        if n == 0 || x + n > width {
+                            return Err(invalid("a literal passes the end of the scanline or is empty"));
+                        }
+                        for p in &mut line[x..x + n] {
+                            p[c] = byte(r)?;
+                        }
+                        x += n;
+                    }
+                }
+            }
+            return Ok(());
+        }
+        // Flat pixels, where `1 1 1 n` repeats the previous pixel n times (n shifted by 8
+        // bits for each marker in a row).
+        if first[..3] == [1, 1, 1] {
+            return Err(invalid("a scanline starts with a repeat marker"));
+        }
+        line[0] = first;
+        let (mut x, mut shift) = (1, 0u32);
+        while x < width {
+            let mut p = [0u8; 4];
+            r.read_exact(&mut p)?;
+            if p[..3] == [1, 1, 1] {
+                let run = (p[3] as usize).checked_shl(shift).unwrap_or(usize::MAX);
+                if run > width - x {
+                    return Err(invalid("a repeat passes the end of the scanline"));
+                }
+                let prev = line[x - 1];
+                line[x..x + run].iter_mut().for_each(|q| *q = prev);
+                x += run;
+                shift += 8;
+            } else {
+                line[x] = p;
+                x += 1;
+                shift = 0;
+            }
+        }
+        Ok(())
+    }
+
+    /// An RGBE pixel as linear RGB, exactly as the `image` crate converts it:
+    /// `2^(e−128)/256` built from the bits (subnormal for `e = 1`), 0 for `e = 0`.
+    pub fn to_f32(p: [u8; 4]) -> [f32; 3] {
+        let e = p[3] as u32;
+        let exp = f32::from_bits(if e > 1 { (e - 1) << 23 } else { e << 22 }) * 0.00390625;
+        [exp * p[0] as f32, exp * p[1] as f32, exp * p[2] as f32]
+    }
 }
 
 fn check_side(path: &Path, w: u32, h: u32) -> Result<()> {

@@ -284,3 +284,37 @@ fn large_face_folders_bake_on_the_gpu() {
         assert!(worst < 1e-3, "{name}: worst relative difference {worst}");
     }
 }
+
+/// A `width`×`width/2` Radiance HDR, flat RGBE scanlines written row by row: the same sky
+/// as [`write_equirect`].
+fn write_hdr(path: &Path, width: usize) {
+    use std::io::Write;
+    let h = width / 2;
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    write!(f, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {width}\n").unwrap();
+    let mut row = vec![0u8; 4 * width];
+    for y in 0..h {
+        for x in 0..width {
+            let n = ((x as u32).wrapping_mul(0x9E37_79B9) ^ (y as u32).wrapping_mul(0x85EB_CA6B)).rotate_left(13).wrapping_mul(0xC2B2_AE35);
+            // Mantissas 64..255 at exponent 128: values 0.25..1 (flat, not run-length coded).
+            row[4 * x..4 * x + 4].copy_from_slice(&[64 + (n >> 26) as u8 * 3, 100, 64 + (y * 191 / h) as u8, 128]);
+        }
+        f.write_all(&row).unwrap();
+    }
+}
+
+/// A 16384×8192 Radiance HDR bakes with the defaults in at most 2 GiB.
+#[test]
+fn a_16k_hdr_bakes_within_2_gib() {
+    let d = scratch("16k-hdr");
+    let env = d.join("16k.hdr");
+    write_hdr(&env, 16384);
+    let mut c = runner();
+    c.args(["bake", env.to_str().unwrap(), "--backend", "cpu", "--out", d.join("out").to_str().unwrap()]);
+    let (ok, said, peak) = run_measured(c, &d);
+    assert!(ok, "{said}");
+    assert!(said.contains("16384×8192 read as 2048×1024"), "{said}");
+    eprintln!("peak RSS {:.0} MiB", peak as f64 / 1048576.0);
+    assert!(peak <= 2 << 30, "peak RSS {:.0} MiB", peak as f64 / 1048576.0);
+    let _ = std::fs::remove_dir_all(&d);
+}
