@@ -222,13 +222,15 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
     let settings = Settings { source_size: sweep.source_size, size: sweep.source_size, ..Settings::default() };
     let source = bake::source_cube(&Backend::Cpu, env, &settings)?;
     let texels = reference::texels(source.level(0), sweep.source_size);
-    eprintln!("report: references (f64) …");
-    let refs = References::compute(sweep, &texels);
+    let refs = {
+        let _step = crate::progress::step("report: references (f64)", None);
+        References::compute(sweep, &texels)
+    };
     let mut rows = Vec::new();
     rows.extend(refs.split_error_rows());
     for backend in backends {
         let b = backend.describe();
-        eprintln!("report: {b} …");
+        let _step = crate::progress::step(&format!("report: every product on {b}"), None);
         // Warm-up, outside the timings: first dispatches pay for driver set-up and caches.
         backend.brdf_lut(4, 4)?;
         backend.brdf_table(4, splitsum_shaders::brdf::microfacet::Masking::SmithSchlick)?;
@@ -244,11 +246,17 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
     let methods = sweep.methods(native);
     let src = methods[0].settings.source_size;
     let acc_source = bake::source_cube(&Backend::Cpu, env, &Settings { source_size: src, size: src, ..Settings::default() }.fitted())?;
-    eprintln!("report: end-to-end references (f64, {} shading points, {} lookups, {src}² source) …", sweep.accuracy_points.0, sweep.accuracy_points.1);
-    let points = crate::accuracy::Points::new(&acc_source, sweep.accuracy_points.0, sweep.accuracy_points.1);
+    let points = {
+        let what =
+            format!("report: end-to-end references (f64, {} shading points, {} lookups, {src}² source)", sweep.accuracy_points.0, sweep.accuracy_points.1);
+        let _step = crate::progress::step(&what, None);
+        crate::accuracy::Points::new(&acc_source, sweep.accuracy_points.0, sweep.accuracy_points.1)
+    };
     for backend in backends {
+        let _step = crate::progress::step(&format!("report: end to end on {}", backend.describe()), None);
         rows.extend(crate::accuracy::measure(backend, env, &methods, &points)?);
     }
+    let _step = crate::progress::step("report: writing report.md, report.csv, error_vs_time.png", None);
     write_outputs(dir, name, backends, sweep, &rows)?;
     Ok(rows)
 }

@@ -39,7 +39,10 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
         let model = scene.model()?;
         let (w, h) = (scene.output.width, scene.output.height);
         let start = Instant::now();
-        let pixels = render_frame(&backend, &sb.env, &view.frame(sb.env.shape(), w, h, true), model.as_ref())?;
+        let pixels = {
+            let _step = crate::progress::step(&format!("rendering {w}×{h}"), None);
+            render_frame(&backend, &sb.env, &view.frame(sb.env.shape(), w, h, true), model.as_ref())?
+        };
         files::write_rgb8(&args.out, w, h, &crate::render::to_rgb8(&pixels), format)?;
         println!("rendered {w}×{h} in {:.3} s: {}", start.elapsed().as_secs_f64(), view.summary());
         println!("wrote {}", args.out.display());
@@ -57,7 +60,10 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
     let model = args.look.load_model()?;
     let start = Instant::now();
     let frame = view.frame(baked.shape(), args.width, args.height, true);
-    let pixels = render_frame(&backend, &baked, &frame, model.as_ref())?;
+    let pixels = {
+        let _step = crate::progress::step(&format!("rendering {}×{}", args.width, args.height), None);
+        render_frame(&backend, &baked, &frame, model.as_ref())?
+    };
     let render_secs = start.elapsed().as_secs_f64();
     files::write_rgb8(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels), format)?;
     println!("{name} on {}: bake {bake_secs:.2} s, render {render_secs:.3} s", backend.describe());
