@@ -54,7 +54,8 @@ pub struct SceneArgs {
     /// scene sets the environment, quality, camera, models, lights and output size.
     #[arg(long)]
     pub scene: Option<PathBuf>,
-    /// Bake again even if the cache holds this bake.
+    /// Bake again even if the cache holds this bake, and run even if the bake is estimated
+    /// to take over an hour.
     #[arg(long)]
     pub force: bool,
     /// The cache folder [default: $SPLITSUM_CACHE, $XDG_CACHE_HOME/splitsum or ~/.cache/splitsum].
