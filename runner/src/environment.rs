@@ -475,8 +475,8 @@ pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputRe
 /// `factor` in both axes: each output texel is the solid-angle-weighted mean
 /// (`equirect::row_solid_angle`) of the `factor²` input texels it covers, summed in f64.
 /// Only the output rows still being filled hold f64 sums, so memory is the output image
-/// plus a few rows, whatever the input's size. A `height` of 1 weighs every texel alike
-/// (a plain list of texels, or a cube face at factor 1).
+/// plus a few rows, whatever the input's size. At factor 1 nothing is summed and no weight
+/// plays a part: texels are only cleaned (a plain list of texels, a cube face).
 struct Reducer {
     width: u32,
     height: u32,
@@ -487,7 +487,7 @@ struct Reducer {
     pending: Vec<Option<Box<[f64]>>>,
     /// Input texels received per output row.
     arrived: Vec<u32>,
-    /// Solid angle of each input row.
+    /// Solid angle of each input row (empty at factor 1, where nothing is summed).
     row_weight: Vec<f64>,
     /// (output texel, channels that are +∞ (bit k), weight, already counted as clamped) of
     /// each input with a +∞ channel: replaced by the channel's largest finite value when the
@@ -501,7 +501,7 @@ impl Reducer {
     fn new(width: u32, height: u32, factor: u32, sanitize: bool) -> Self {
         let factor = if width % factor == 0 && height % factor == 0 { factor.max(1) } else { 1 };
         let (ow, oh) = (width / factor, height / factor);
-        let row_weight = if height == 1 { vec![1.0] } else { (0..height).map(|y| equirect::row_solid_angle(y, height) as f64).collect() };
+        let row_weight = if factor > 1 { (0..height).map(|y| equirect::row_solid_angle(y, height) as f64).collect() } else { Vec::new() };
         Self {
             width,
             height,
@@ -552,7 +552,7 @@ impl Reducer {
         }
         self.report.negative += negative as u64;
         self.report.clamped += clamped as u64;
-        let w = self.row_weight[y as usize];
+        let w = if f == 1 { 1.0 } else { self.row_weight[y as usize] };
         let mask = (infinite[0] as u8) | (infinite[1] as u8) << 1 | (infinite[2] as u8) << 2;
         if mask != 0 {
             self.infinite.push(((oy * ow + ox) as u32, mask, w, clamped));
