@@ -36,7 +36,7 @@ enum Command {
     Bake(bake::BakeArgs),
     /// Time every product of a bake on each backend (a benchmark, not a test).
     Bench(bench::BenchArgs),
-    /// Render the scene offscreen to a PNG (works without a display, on lavapipe or the CPU).
+    /// Render the scene offscreen to a PNG or JPEG (works without a display, on lavapipe or the CPU).
     Render(render::RenderArgs),
     /// Open the interactive viewer (needs a display; `runner render` does without).
     View(view::ViewArgs),
