@@ -235,6 +235,11 @@ impl Settings {
         (0..self.mips).map(|m| (self.samples as u64 * (self.sample_growth as u64).pow(m.saturating_sub(1))).min(1 << 20) as u32).collect()
     }
 
+    /// Every mip of the specular cube: `0 .. mips`.
+    pub fn all_levels(&self) -> Vec<u32> {
+        (0..self.mips).collect()
+    }
+
     /// Layout of the specular cube.
     pub fn specular_layout(&self) -> CubeLayout {
         CubeLayout::new(self.size, self.mips)
@@ -314,27 +319,32 @@ pub fn step_estimates(backend: &Backend, env: &Environment, settings: &Settings,
 /// Runs estimated over this many seconds are refused unless forced.
 pub const MAX_UNFORCED_SECONDS: f64 = 3600.0;
 
-/// Refuses a bake estimated (`estimates`, see [`step_estimates`]) to take over an hour,
-/// unless `force`: naming the estimate, its longest step and the flags that set it.
-pub fn check_duration(estimates: &[f64; 4], force: bool) -> Result<()> {
+/// The flags that set the cost of each of `plan::STEPS`, for [`check_duration`]'s message.
+const STEP_FLAGS: [&str; 4] =
+    ["--source-size and --supersample", "--samples, --sample-growth and --size", "--lut-size and --lut-samples", "--irradiance-size and --irradiance-source"];
+
+/// Refuses a run estimated (`estimates`, seconds per `plan::STEPS`) to take over an hour,
+/// unless `force`: naming the estimate, its longest step and the flags that set it
+/// (`flags`, per step: [`STEP_FLAGS`] for a bake).
+pub fn check_duration(estimates: &[f64; 4], flags: &[&str; 4], force: bool) -> Result<()> {
     let total: f64 = estimates.iter().sum();
     if total <= MAX_UNFORCED_SECONDS || force {
         return Ok(());
     }
     let (k, longest) = estimates.iter().copied().enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).expect("four steps");
-    let knobs = [
-        "--source-size and --supersample",
-        "--samples, --sample-growth and --size",
-        "--lut-size and --lut-samples",
-        "--irradiance-size and --irradiance-source",
-    ];
     Err(Error::Invalid(format!(
         "this bake is estimated to take {} ({} of it for the {}); lower {} (scene: [quality]), or pass --force to run it anyway",
         crate::progress::seconds(total),
         crate::progress::seconds(longest),
         crate::plan::STEPS[k],
-        knobs[k]
+        flags[k]
     )))
+}
+
+/// [`check_duration`] of baking `products` (and `levels` of the specular cube) of `env`
+/// with `settings` on `backend`.
+pub fn check_bake_duration(backend: &Backend, env: &Environment, settings: &Settings, products: Products, levels: &[u32], force: bool) -> Result<()> {
+    check_duration(&step_estimates(backend, env, settings, products, levels), &STEP_FLAGS, force)
 }
 
 /// The source cube of `env` for `settings`: resampled from an equirect, or the given faces
@@ -374,7 +384,7 @@ pub fn brdf_table(backend: &Backend, settings: &Settings) -> Result<Lut> {
 pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products: Products) -> Result<Baked> {
     settings.validate()?;
     let mut timings = Vec::new();
-    let all: Vec<u32> = (0..settings.mips).collect();
+    let all = settings.all_levels();
     let est = step_estimates(backend, env, settings, products, &all);
     let source = timed(&mut timings, "source cube", &est, || source_cube(backend, env, settings))?;
     let specular = if products.specular {
@@ -700,7 +710,7 @@ pub fn bake_scene(
             crate::cache::Lookup::Rejected(why) => outcome = Outcome::Rebuilt(why),
         }
     }
-    check_duration(&step_estimates(backend, &env, &plan.settings, plan.products, &plan.levels), force)?;
+    check_bake_duration(backend, &env, &plan.settings, plan.products, &plan.levels, force)?;
     let (baked, timings) = bake_plan(backend, &env, &plan)?;
     if let Some(c) = cache {
         c.put(&key, &baked)?;

@@ -42,8 +42,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let out = files::OutputDir::begin(&args.out, "--out")?;
     let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
     let backend = Backend::open(args.backend)?;
-    let all: Vec<u32> = (0..settings.mips).collect();
-    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, Products::ALL, &all), args.scene.force)?;
+    bake::check_bake_duration(&backend, &env, &settings, Products::ALL, &settings.all_levels(), args.scene.force)?;
     println!("baking {} on {}", env_path.display(), backend.describe());
     let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
     let manifest = bake::Manifest {

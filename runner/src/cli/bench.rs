@@ -44,8 +44,7 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 continue;
             }
         };
-        let all: Vec<u32> = (0..settings.mips).collect();
-        bake::check_duration(&bake::step_estimates(&backend, &env, &settings, Products::ALL, &all), args.force)?;
+        bake::check_bake_duration(&backend, &env, &settings, Products::ALL, &settings.all_levels(), args.force)?;
         let mut best: Vec<bake::Timing> = Vec::new();
         for _ in 0..args.runs.max(1) {
             let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;

@@ -42,16 +42,13 @@ pub(super) fn lut(args: LutArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     let masking = args.masking.unwrap_or(args.method.default_masking());
     let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: masking, ..Settings::default() };
-    if args.samples == 0 {
-        anyhow::bail!("--samples must be at least 1");
-    }
     if settings.lut_method == TableMethod::Sampled && settings.lut_masking != MaskingModel::Schlick {
         anyhow::bail!("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)");
     }
+    // The table is the cost model's third step (`plan::STEPS[2]`); a table needs no source cube.
     let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };
-    let mut estimate = crate::plan::step_seconds(&settings, only_table, &[], 0, &crate::plan::Calibration::default(), matches!(backend, Backend::Gpu(_)));
-    estimate[0] = 0.0; // the cost model's source cube: a table needs none
-    bake::check_duration(&estimate, args.force).map_err(|e| anyhow::anyhow!(e.to_string().replace("--lut-size and --lut-samples", "--size and --samples")))?;
+    let table = crate::plan::step_seconds(&settings, only_table, &[], 0, &crate::plan::Calibration::default(), matches!(backend, Backend::Gpu(_)))[2];
+    bake::check_duration(&[0.0, 0.0, table, 0.0], &["", "", "--size and --samples", ""], args.force)?;
     let lut = bake::brdf_table(&backend, &settings)?;
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;

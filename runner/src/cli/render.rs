@@ -52,7 +52,7 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(args.backend)?;
     let settings = args.bake.settings(&env);
-    bake::check_duration(&bake::step_estimates(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &(0..settings.mips).collect::<Vec<_>>()), args.scene.force)?;
+    bake::check_bake_duration(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &settings.all_levels(), args.scene.force)?;
     let start = Instant::now();
     let baked = bake::bake_for_display(&backend, &env, &settings)?;
     let bake_secs = start.elapsed().as_secs_f64();
