@@ -1,22 +1,32 @@
 #!/usr/bin/env bash
 # splitsum's one entry point for people and CI. It installs what the project needs on a
-# fresh machine (the nightly rust-gpu is pinned to, and Mesa's lavapipe Vulkan driver so
-# the GPU backend runs without a GPU), then runs:
+# fresh machine (stable Rust, and Mesa's lavapipe Vulkan driver so the GPU backend runs
+# without a GPU), then runs:
 #
 #   bash scripts/dev.sh run [ARGS...]   # the runner (no ARGS: the default bake and view)
 #   bash scripts/dev.sh test            # every test, optimised (the CPU path is slow in debug)
-#   bash scripts/dev.sh cargo ARGS...   # any cargo command with the pinned toolchain
+#   bash scripts/dev.sh cargo ARGS...   # any cargo command, on stable
+#   bash scripts/dev.sh spirv [--check] # regenerate spirv/src from shaders/ (or check it is
+#                                       # current): rust-gpu, on the nightly it pins
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-TOOLCHAIN=nightly-2026-08-15
+# The build and tests need only stable; rust-gpu (the `spirv` command) needs this nightly.
+NIGHTLY=nightly-2026-08-15
 
-ensure_toolchain() {
+ensure_stable() {
+    if ! rustup run stable cargo --version >/dev/null 2>&1; then
+        echo "dev.sh: installing stable Rust" >&2
+        rustup toolchain install stable --profile minimal >&2
+    fi
+}
+
+ensure_nightly() {
     local have
-    have=$(rustup component list --toolchain "$TOOLCHAIN" --installed 2>/dev/null || true)
+    have=$(rustup component list --toolchain "$NIGHTLY" --installed 2>/dev/null || true)
     if ! grep -q '^rust-src' <<<"$have" || ! grep -q '^rustc-dev' <<<"$have" || ! grep -q '^llvm-tools' <<<"$have"; then
-        echo "dev.sh: installing $TOOLCHAIN with rust-src, rustc-dev, llvm-tools (rust-gpu needs exactly this nightly)" >&2
-        rustup toolchain install "$TOOLCHAIN" --profile minimal -c rust-src -c rustc-dev -c llvm-tools >&2
+        echo "dev.sh: installing $NIGHTLY with rust-src, rustc-dev, llvm-tools (rust-gpu needs exactly this nightly)" >&2
+        rustup toolchain install "$NIGHTLY" --profile minimal -c rust-src -c rustc-dev -c llvm-tools >&2
     fi
 }
 
@@ -61,22 +71,28 @@ fi
 
 cmd=${1:-run}
 [ $# -gt 0 ] && shift
-ensure_toolchain
 case "$cmd" in
     run)
+        ensure_stable
         ensure_vulkan
-        exec cargo +"$TOOLCHAIN" run --release -p runner -- "$@"
+        exec cargo +stable run --release -p runner -- "$@"
         ;;
     test)
+        ensure_stable
         ensure_vulkan
         ensure_test_display
-        exec cargo +"$TOOLCHAIN" test --release --workspace "$@"
+        exec cargo +stable test --release --workspace "$@"
         ;;
     cargo)
-        exec cargo +"$TOOLCHAIN" "$@"
+        ensure_stable
+        exec cargo +stable "$@"
+        ;;
+    spirv)
+        ensure_nightly
+        exec cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
         ;;
     *)
-        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS..." >&2
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | spirv [--check]" >&2
         exit 2
         ;;
 esac

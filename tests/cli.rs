@@ -52,7 +52,7 @@ fn a_failed_run_leaves_the_existing_output_alone() {
     let _ = err(&["lut", "--samples", "0", "--backend", "cpu", "--out", out.to_str().unwrap()]);
     assert_eq!(std::fs::read(&out).unwrap(), b"previous result");
     // A write that fails half-way leaves the old file and no temporary behind.
-    let r = runner::files::write_atomic(&out, |w| {
+    let r = splitsum::files::write_atomic(&out, |w| {
         use std::io::Write;
         w.write_all(b"half")?;
         Err(std::io::Error::other("disk full"))
@@ -91,8 +91,8 @@ fn lut_writes_exr_and_png() {
 
 #[test]
 fn missing_gpu_names_the_cpu_backend_and_lavapipe() {
-    let e = runner::gpu::Gpu::matching(Some("no-such-adapter-anywhere")).err().expect("no adapter").to_string();
-    assert!(e.contains("--backend cpu") && e.contains("mesa-vulkan-drivers"), "{e}");
+    let e = splitsum::backend::Gpu::matching(Some("no-such-adapter-anywhere")).err().expect("no adapter").to_string();
+    assert!(e.contains("on the CPU") && e.contains("mesa-vulkan-drivers") && !e.contains("--"), "the library's own terms: {e}");
 }
 
 fn repo(path: &str) -> String {
@@ -213,6 +213,6 @@ fn a_broken_draco_model_names_the_extension() {
     let d = scratch("draco");
     let model = d.join("draco.gltf");
     std::fs::write(&model, r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],"accessors":[{"componentType":5126,"count":3,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"extensions":{"KHR_draco_mesh_compression":{"bufferView":0,"attributes":{"POSITION":0}}}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}"#).unwrap();
-    let e = format!("{}", runner::model::load(&model).map(|_| ()).expect_err("refused"));
+    let e = format!("{}", splitsum_display::model::load(&model).map(|_| ()).expect_err("refused"));
     assert!(e.contains("KHR_draco_mesh_compression") && !e.contains("Missing data"), "{e}");
 }

@@ -1,7 +1,7 @@
 //! Equirect conventions and the area-correct resampling to a cube.
 
-use runner::Backend;
-use runner::texture::Equirect;
+use splitsum::Backend;
+use splitsum::texture::Equirect;
 use splitsum_shaders::equirect;
 use splitsum_shaders::glam::{Vec2, Vec3, Vec4};
 use std::f64::consts::PI;
@@ -36,7 +36,7 @@ fn equirect_texel_omega(y: u32, width: u32, height: u32) -> f64 {
     2.0 * PI / width as f64 * (t0.cos() - t1.cos())
 }
 
-fn cube_power(cube: &runner::texture::Cube) -> f64 {
+fn cube_power(cube: &splitsum::texture::Cube) -> f64 {
     reference::texels(cube.level(0), cube.layout.size).iter().map(|(_, o, c)| o * c[0]).sum()
 }
 
@@ -76,8 +76,8 @@ fn a_small_sun_keeps_its_power() {
 
 #[test]
 fn gpu_matches_cpu_on_a_real_environment() {
-    let (envr, _) = runner::environment::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/city.exr")), false).unwrap();
-    let runner::environment::Environment::Equirect(e) = envr else { panic!() };
+    let (envr, _) = splitsum::environment::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/city.exr")), false).unwrap();
+    let splitsum::environment::Environment::Equirect(e) = envr else { panic!() };
     let n = equirect::supersampling(64, e.width, 2.0);
     let g = support::gpu().equirect_to_cube(&e, 64, n).unwrap();
     let c = Backend::Cpu.equirect_to_cube(&e, 64, n).unwrap();
@@ -123,9 +123,9 @@ fn reading_for_a_cube_reduces_the_image_and_keeps_its_power() {
     let height = width / 2;
     let power: f64 = (0..height).map(|y| (0..width).map(|x| noisy_sky(x, y, width, sun) as f64).sum::<f64>() * equirect_texel_omega(y, width, height)).sum();
 
-    let (reduced, report) = runner::environment::load_for(&path, false, 256).unwrap();
-    let (full, _) = runner::environment::load_for(&path, false, 4096).unwrap();
-    let runner::environment::Environment::Equirect(r) = &reduced else { panic!() };
+    let (reduced, report) = splitsum::environment::load_for(&path, false, 256).unwrap();
+    let (full, _) = splitsum::environment::load_for(&path, false, 4096).unwrap();
+    let splitsum::environment::Environment::Equirect(r) = &reduced else { panic!() };
     assert_eq!((r.width, r.height, report.original), (2048, 1024, (4096, 2048)));
     let reduced_power: f64 = (0..r.height)
         .map(|y| (0..r.width).map(|x| r.texels[(y * r.width + x) as usize].x as f64).sum::<f64>() * equirect_texel_omega(y, r.width, r.height))
@@ -133,10 +133,10 @@ fn reading_for_a_cube_reduces_the_image_and_keeps_its_power() {
     // f32 texels (7 significant digits) and f32 row weights: 1e-5 relative.
     assert!((reduced_power / power - 1.0).abs() < 1e-5, "power {reduced_power} vs {power}");
 
-    let settings = runner::bake::Settings::default();
-    let products = runner::bake::Products { specular: true, irradiance: true, sh9: false, lut: false };
-    let a = runner::bake::bake(&Backend::Cpu, &reduced, &settings, products).unwrap();
-    let b = runner::bake::bake(&Backend::Cpu, &full, &settings, products).unwrap();
+    let settings = splitsum::settings::Settings::default();
+    let products = splitsum::settings::Products { specular: true, irradiance: true, sh9: false, lut: false };
+    let a = splitsum::bake::bake(&Backend::Cpu, &reduced, &settings, products).unwrap();
+    let b = splitsum::bake::bake(&Backend::Cpu, &full, &settings, products).unwrap();
     // Both source cubes hold the file's power, the sun's included: the resampling keeps a
     // one-texel sun's power within 1.3 % (a_small_sun_keeps_its_power); over this 60-texel
     // sun and the sky, measured 1.5e-4 apart.

@@ -1,9 +1,9 @@
 //! Files in and out: KTX2 that a reader accepts, the half-float overflow rule, and clear
 //! errors for missing, truncated, malformed, misshapen and non-finite inputs.
 
-use runner::environment::{self, Environment};
-use runner::ktx2::{self, Format};
-use runner::texture::Cube;
+use splitsum::environment::{self, Environment};
+use splitsum::ktx2::{self, Format};
+use splitsum::texture::Cube;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::glam::Vec4;
 use std::path::{Path, PathBuf};
@@ -159,7 +159,7 @@ fn non_finite_texels_are_refused_unless_sanitised() {
         _ => 1.0,
     });
     let e = load_err(&p);
-    assert!(e.contains("nan.exr") && e.contains("1 texels with NaN") && e.contains("3 with an infinite") && e.contains("--sanitize"), "{e}");
+    assert!(e.contains("nan.exr") && e.contains("1 texels with NaN") && e.contains("3 with an infinite") && e.contains("sanitising"), "{e}");
     let (env, report) = environment::load(&p, true).unwrap();
     assert_eq!((report.nan, report.infinite, report.negative), (1, 3, 1));
     let Environment::Equirect(e) = env else { panic!() };

@@ -4,7 +4,7 @@
 //! `PROPTEST_CASES` raises the budget (default 48 cases per loader, a few seconds here).
 
 use proptest::prelude::*;
-use runner::environment;
+use splitsum::environment;
 use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
@@ -90,8 +90,8 @@ proptest! {
     fn gltf_models(e in edits()) {
         let d = scratch("gltf");
         let p = d.join("model.glb");
-        std::fs::write(&p, mutate(runner::model::EMBEDDED_SAMPLE, &e.0, e.1)).unwrap();
-        let _ = runner::model::load(&p);
+        std::fs::write(&p, mutate(splitsum_display::model::EMBEDDED_SAMPLE, &e.0, e.1)).unwrap();
+        let _ = splitsum_display::model::load(&p);
     }
 
     #[test]
@@ -99,21 +99,21 @@ proptest! {
         let d = scratch("draco");
         let p = d.join("model.glb");
         std::fs::write(&p, mutate(&support::model::draco_torus_glb(speed), &e.0, e.1)).unwrap();
-        let _ = runner::model::load(&p);
+        let _ = splitsum_display::model::load(&p);
     }
 
     #[test]
     fn scene_files(e in edits(), text in "[\\[\\]a-z_=\"0-9.,{} \n-]{0,200}") {
         let seed = std::fs::read(format!("{}/../scenes/brushed-metal.toml", env!("CARGO_MANIFEST_DIR"))).unwrap();
         let mutated = String::from_utf8_lossy(&mutate(&seed, &e.0, e.1)).into_owned();
-        let _ = runner::scene::Scene::parse(&mutated);
-        let _ = runner::scene::Scene::parse(&text);
+        let _ = splitsum_display::scene::Scene::parse(&mutated);
+        let _ = splitsum_display::scene::Scene::parse(&text);
     }
 
     #[test]
     fn cache_entries(file in 0usize..5, e in edits()) {
         let d = scratch(&format!("cache-{file}"));
-        let cache = runner::cache::Cache::new(&d);
+        let cache = splitsum::cache::Cache::new(&d);
         let env = support::small_display_bake();
         cache.put("k", &env).unwrap();
         let mut entries: Vec<PathBuf> = std::fs::read_dir(cache.entry("k")).unwrap().map(|x| x.unwrap().path()).collect();
@@ -128,13 +128,13 @@ proptest! {
     /// floats), reads back with the `ktx2` crate: six faces per level, every level there.
     #[test]
     fn ktx2_read_back(size_log in 0u32..4, values in prop::collection::vec(any::<f32>(), 1..64), half in any::<bool>()) {
-        use runner::ktx2::{self, Format};
+        use splitsum::ktx2::{self, Format};
         use splitsum_shaders::cubemap::CubeLayout;
         use splitsum_shaders::glam::Vec4;
         let size = 1u32 << size_log;
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
         let texels = (0..layout.texel_count() as usize).map(|i| Vec4::new(values[i % values.len()], values[(i + 1) % values.len()], values[(i + 2) % values.len()], 1.0)).collect();
-        let cube = runner::texture::Cube { layout, texels };
+        let cube = splitsum::texture::Cube { layout, texels };
         let (bytes, _) = ktx2::encode(&cube, if half { Format::Rgba16f } else { Format::Auto });
         let reader = ::ktx2::Reader::new(&bytes[..]).expect("splitsum's KTX2 parses");
         prop_assert_eq!(reader.header().face_count, 6);

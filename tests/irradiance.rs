@@ -1,7 +1,7 @@
 //! Diffuse irradiance: constants, a closed form, the exact sum over every source texel,
 //! SH9 against the convolution, and GPU against CPU.
 
-use runner::Backend;
+use splitsum::Backend;
 use splitsum_shaders::cubemap;
 use splitsum_shaders::glam::{Vec3, Vec4};
 use splitsum_shaders::irradiance::sh9_irradiance;

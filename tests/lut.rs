@@ -11,7 +11,7 @@ use support::{gpu, max_diffs, reference};
 fn gpu_matches_cpu() {
     let (size, samples) = (128, 256);
     let g = gpu().brdf_lut(size, samples).expect("gpu bake");
-    let c = runner::Backend::Cpu.brdf_lut(size, samples).expect("cpu bake");
+    let c = splitsum::Backend::Cpu.brdf_lut(size, samples).expect("cpu bake");
     let (abs, ulp) = max_diffs(g.texels.iter().flat_map(|t| [t.x, t.y]), c.texels.iter().flat_map(|t| [t.x, t.y]));
     println!("brdf lut {size}² × {samples} samples, gpu vs cpu: max |Δ| = {abs:.3e}, max {ulp} ULP");
     assert!(abs <= 1.5e-6, "gpu and cpu differ by {abs:e}");
@@ -147,7 +147,7 @@ fn quadrature_table_gpu_matches_cpu() {
     use splitsum_shaders::brdf::microfacet::Masking;
     for masking in [Masking::SmithSchlick, Masking::SmithCorrelated] {
         let g = gpu().brdf_table(64, masking).expect("gpu bake");
-        let c = runner::Backend::Cpu.brdf_table(64, masking).expect("cpu bake");
+        let c = splitsum::Backend::Cpu.brdf_table(64, masking).expect("cpu bake");
         let (abs, ulp) = max_diffs(g.texels.iter().flat_map(|t| [t.x, t.y]), c.texels.iter().flat_map(|t| [t.x, t.y]));
         println!("brdf table 64² by quadrature ({masking:?}), gpu vs cpu: max |Δ| = {abs:.3e}, max {ulp} ULP");
         // Hardware may round division and sqrt to 3 ULP and fuse multiply–adds (Vulkan allows

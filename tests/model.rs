@@ -1,8 +1,8 @@
 //! glTF models: the bundled sample is current, loads with its transforms and every
 //! texture, and the GPU draws it as the CPU reference rasteriser does.
 
-use runner::Backend;
-use runner::render::{GpuModel, GpuScene, ViewState};
+use splitsum::Backend;
+use splitsum_display::render::{GpuModel, GpuScene, ViewState};
 use splitsum_shaders::glam::{Vec3, Vec4};
 use std::path::PathBuf;
 
@@ -23,7 +23,7 @@ fn committed_sample_model_is_current() {
 
 #[test]
 fn loads_with_node_transforms_and_every_texture() {
-    let m = runner::model::load(&sample_path()).unwrap();
+    let m = splitsum_display::model::load(&sample_path()).unwrap();
     assert_eq!(m.primitives.len(), 1);
     let p = &m.primitives[0];
     assert!(p.textures.iter().all(|t| t.is_some()), "all five slots");
@@ -41,7 +41,7 @@ fn loads_with_node_transforms_and_every_texture() {
         assert!((Vec4::from(v.tangent).truncate().length() - 1.0).abs() < 1e-5);
     }
     // Errors name the file.
-    let e = runner::model::load(std::path::Path::new("/no/such/model.glb")).unwrap_err().to_string();
+    let e = splitsum_display::model::load(std::path::Path::new("/no/such/model.glb")).unwrap_err().to_string();
     assert!(e.contains("/no/such/model.glb"), "{e}");
 }
 
@@ -54,7 +54,7 @@ fn loads_with_node_transforms_and_every_texture() {
 #[test]
 fn gpu_draws_the_model_as_the_cpu_reference() {
     let baked = support::small_display_bake();
-    let mut model = runner::model::load(&sample_path()).unwrap();
+    let mut model = splitsum_display::model::load(&sample_path()).unwrap();
     model.fit(Vec3::new(0.0, 0.0, 1.5), 4.0);
     let Backend::Gpu(gpu) = support::gpu() else { unreachable!() };
     let scene = GpuScene::new(gpu, &baked);
@@ -63,8 +63,8 @@ fn gpu_draws_the_model_as_the_cpu_reference() {
     let (w, h) = (256, 160);
     let frame = view.frame(scene.shape, w, h, true);
     let g = scene.render_offscreen(gpu, &frame, Some(&gpu_model)).unwrap();
-    let c = runner::raster::render(&baked, &frame, &model);
-    let no_model = runner::render::render_cpu(&baked, &frame);
+    let c = splitsum_display::raster::render(&baked, &frame, &model);
+    let no_model = splitsum_display::render::render_cpu(&baked, &frame);
     let (mut n, mut over, mut sum, mut worst) = (0usize, 0usize, 0.0f64, 0.0f32);
     for i in 0..g.len() {
         // A model pixel in either image (1e-3: well above the spheres' GPU-vs-CPU difference).
@@ -80,10 +80,10 @@ fn gpu_draws_the_model_as_the_cpu_reference() {
     let mean = sum / n as f64;
     if let Some(dir) = std::env::var_os("SPLITSUM_DUMP") {
         let dir = PathBuf::from(dir);
-        runner::files::write_png(&dir.join("model_gpu.png"), w, h, &runner::render::to_rgb8(&g)).unwrap();
-        runner::files::write_png(&dir.join("model_cpu.png"), w, h, &runner::render::to_rgb8(&c)).unwrap();
+        splitsum::files::write_png(&dir.join("model_gpu.png"), w, h, &splitsum_display::render::to_rgb8(&g)).unwrap();
+        splitsum::files::write_png(&dir.join("model_cpu.png"), w, h, &splitsum_display::render::to_rgb8(&c)).unwrap();
         let d: Vec<Vec4> = g.iter().zip(&c).map(|(a, b)| Vec4::splat(((*a - *b).abs().max_element() * 10.0).min(1.0))).collect();
-        runner::files::write_png(&dir.join("model_diff.png"), w, h, &runner::render::to_rgb8(&d)).unwrap();
+        splitsum::files::write_png(&dir.join("model_diff.png"), w, h, &splitsum_display::render::to_rgb8(&d)).unwrap();
     }
     println!("model: {n} pixels; GPU vs CPU mean |Δ| {mean:.2e}, max {worst:.3}, {:.2} % above 2/255", 100.0 * over as f64 / n as f64);
     assert!(n > (w * h) as usize / 10, "the model covers too little of the frame: {n}");
@@ -102,7 +102,7 @@ fn gpu_draws_the_model_as_the_cpu_reference() {
 /// loaded triangle is matched to the original triangle with the nearest centroid.
 #[test]
 fn draco_compressed_models_decode_to_their_geometry() {
-    let (doc, buffers, _) = gltf::import_slice(runner::model::EMBEDDED_SAMPLE).unwrap();
+    let (doc, buffers, _) = gltf::import_slice(splitsum_display::model::EMBEDDED_SAMPLE).unwrap();
     // The Draco GLB's node has no transform: compare in the mesh's own space.
     let node = doc.nodes().find(|n| n.mesh().is_some()).unwrap();
     let prim = node.mesh().unwrap().primitives().next().unwrap();
@@ -132,7 +132,7 @@ fn draco_compressed_models_decode_to_their_geometry() {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("torus-draco.glb");
         std::fs::write(&path, glb).unwrap();
-        let model = runner::model::load(&path).unwrap_or_else(|e| panic!("speed {speed}: {e}"));
+        let model = splitsum_display::model::load(&path).unwrap_or_else(|e| panic!("speed {speed}: {e}"));
         let p = &model.primitives[0];
         assert_eq!(p.indices.len(), indices.len(), "speed {speed}: triangles");
         let (mut worst_pos, mut worst_nrm, mut worst_uv) = (0.0f32, 0.0f32, 0.0f32);

@@ -2,13 +2,15 @@
 //! a render from the reduced bake equals the render from a full bake, unchanged bakes come
 //! from the cache, and corrupt or foreign entries are rebuilt, never used.
 
-use runner::Backend;
-use runner::bake::{self, Outcome, Products};
-use runner::cache::{Cache, Lookup};
-use runner::environment::Environment;
-use runner::plan::{self, Calibration, Plan};
-use runner::render::BakedEnvironment;
-use runner::scene::Scene;
+use splitsum::Backend;
+use splitsum::bake::BakedEnvironment;
+use splitsum::cache::{Cache, Lookup};
+use splitsum::cost::Calibration;
+use splitsum::environment::Environment;
+use splitsum::settings::Products;
+use splitsum_display::plan::{self, Plan};
+use splitsum_display::prepare::{self as bake, Outcome};
+use splitsum_display::scene::Scene;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::scene::Frame;
 use std::path::{Path, PathBuf};
@@ -152,7 +154,7 @@ fn a_maximum_error_picks_the_cheapest_settings_that_meet_it() {
     // irradiance: the 4² level (0.035). The table is by quadrature (within 1e-5), whatever
     // the target.
     assert_eq!((loose.settings.samples, loose.settings.irradiance_source), (16, 4));
-    assert_eq!(loose.settings.lut_method, runner::bake::TableMethod::Quadrature);
+    assert_eq!(loose.settings.lut_method, splitsum::settings::TableMethod::Quadrature);
     // Tight: no measured count reaches 0.05 at r 0.2–0.35 (256 give 0.0596: mip
     // interpolation, not sampling, is what is left), and the plan says so; the irradiance
     // from 4² still meets it (0.035).
@@ -160,10 +162,10 @@ fn a_maximum_error_picks_the_cheapest_settings_that_meet_it() {
     let strict = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.01")));
     // At 0.01 the irradiance needs the 16² level (0.0067; 8² gives 0.0181).
     assert_eq!(strict.settings.irradiance_source, 16);
-    assert_eq!(tight.settings.lut_method, runner::bake::TableMethod::Quadrature);
+    assert_eq!(tight.settings.lut_method, splitsum::settings::TableMethod::Quadrature);
     // A sample count in the scene asks for the sampled table.
     let sampled = planned(&scene("", &format!("{body}\n[quality]\nlut_samples = 64")));
-    assert_eq!((sampled.settings.lut_method, sampled.settings.lut_samples), (runner::bake::TableMethod::Sampled, 64));
+    assert_eq!((sampled.settings.lut_method, sampled.settings.lut_samples), (splitsum::settings::TableMethod::Sampled, 64));
     assert!(tight.decisions.iter().any(|d| d.what == "prefilter samples" && d.why.contains("still above")));
     assert!(tight.cost.cpu_seconds > 2.0 * loose.cost.cpu_seconds);
     // Fixed settings are kept as given.
@@ -189,7 +191,7 @@ fn the_calibration_reads_a_report() {
 const QUICK: &str = "[quality]\nsize = 32\nsamples = 32\nlut_size = 16\nlut_samples = 32\nirradiance_source = 8";
 
 fn environment() -> Environment {
-    runner::environment::load(&assets().join("environments/courtyard.exr"), false).unwrap().0
+    splitsum::environment::load(&assets().join("environments/courtyard.exr"), false).unwrap().0
 }
 
 /// The plan's bake and the full bake at the same settings (every product, every mip).
@@ -209,11 +211,11 @@ fn render(s: &Scene, env: &BakedEnvironment, backend: &Backend) -> Vec<Vec4> {
     frame.flags.x |= Frame::LINEAR;
     let model = s.model().unwrap();
     match (backend, &model) {
-        (Backend::Cpu, Some(m)) => runner::raster::render(env, &frame, m),
-        (Backend::Cpu, None) => runner::render::render_cpu(env, &frame),
+        (Backend::Cpu, Some(m)) => splitsum_display::raster::render(env, &frame, m),
+        (Backend::Cpu, None) => splitsum_display::render::render_cpu(env, &frame),
         (Backend::Gpu(g), m) => {
-            let scene = runner::render::GpuScene::new(g, env);
-            let gm = m.as_ref().map(|m| runner::render::GpuModel::new(g, &scene, m));
+            let scene = splitsum_display::render::GpuScene::new(g, env);
+            let gm = m.as_ref().map(|m| splitsum_display::render::GpuModel::new(g, &scene, m));
             scene.render_offscreen(g, &frame, gm.as_ref()).unwrap()
         }
     }
@@ -294,7 +296,7 @@ fn the_cache_reuses_unchanged_bakes_and_rebuilds_bad_entries() {
     let other = bake::bake_scene(&Backend::Cpu, &more, &cal, Some(&cache), false).unwrap();
     assert_eq!(other.outcome, Outcome::Baked);
     assert_ne!(other.key, first.key);
-    let k = |env: &[u8], plan: &str, backend: &str| runner::cache::key(env, plan, backend);
+    let k = |env: &[u8], plan: &str, backend: &str| splitsum::cache::key(env, plan, backend);
     assert_ne!(k(b"abc", "{}", "cpu"), k(b"abd", "{}", "cpu"), "a byte of the input");
     assert_ne!(k(b"abc", "{}", "cpu"), k(b"abc", "{}", "gpu"), "the backend");
     assert_ne!(k(b"ab", "c{}", "cpu"), k(b"abc", "{}", "cpu"), "the parts are length-delimited");

@@ -1,8 +1,8 @@
 //! The GGX-prefiltered specular cube: white furnace, the roughness-0 mirror, an exact
 //! brute-force reference, bright suns, and GPU against CPU.
 
-use runner::Backend;
-use runner::texture::Cube;
+use splitsum::Backend;
+use splitsum::texture::Cube;
 use splitsum_shaders::cubemap::{self, CubeLayout};
 use splitsum_shaders::glam::{Vec3, Vec4};
 use splitsum_shaders::prefilter::RoughnessMapping;

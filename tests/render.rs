@@ -1,8 +1,8 @@
 //! The display: the GPU renderer against the CPU reference renderer, which evaluates the
 //! same `scene::pixel` per pixel.
 
-use runner::Backend;
-use runner::render::{GpuScene, ViewState, render_cpu};
+use splitsum::Backend;
+use splitsum_display::render::{GpuScene, ViewState, render_cpu};
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
 

@@ -10,7 +10,7 @@ fn quick_report_writes_tables_csv_and_plot() {
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     let png = image::open(dir.join("error_vs_time.png")).expect("a PNG").to_rgb8();
     assert!(png.width() > 500 && png.height() > 300);
-    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(runner::report::csv_fields).collect();
+    let rows: Vec<Vec<String>> = csv.lines().skip(1).map(splitsum_report::report::csv_fields).collect();
     for product in ["brdf lut", "prefilter r=0.33", "irradiance (convolution)", "irradiance (SH9)", "shaded colour (n.v >= 0.6)"] {
         for backend in ["gpu", "cpu"] {
             assert!(rows.iter().any(|r| r[0] == product && r[1].starts_with(backend)), "no {product} on {backend}");
@@ -51,17 +51,17 @@ fn quick_report_writes_tables_csv_and_plot() {
 /// n·v stands in for the table's F₀) but finite.
 #[test]
 fn end_to_end_measure_of_a_constant_sky() {
-    use runner::accuracy::{Method, Points};
-    use runner::bake::Settings;
-    use runner::environment::Environment;
-    use runner::texture::Equirect;
+    use splitsum::environment::Environment;
+    use splitsum::settings::Settings;
+    use splitsum::texture::Equirect;
+    use splitsum_report::accuracy::{Method, Points};
     use splitsum_shaders::glam::Vec4;
     let env = Environment::Equirect(Equirect { width: 64, height: 32, texels: vec![Vec4::new(0.5, 1.0, 2.0, 1.0); 64 * 32] });
     let settings = Settings { size: 16, source_size: 16, ..Settings::default() }.fitted();
-    let source = runner::bake::source_cube(&runner::Backend::Cpu, &env, &settings).unwrap();
+    let source = splitsum::bake::host_source_cube(&splitsum::Backend::Cpu, &env, &settings).unwrap();
     let points = Points::new(&source, 48, 32);
     let methods = [Method { label: "defaults".into(), family: "defaults", settings, flags: splitsum_shaders::shade::ShadeOptions::DEFAULT.flags }];
-    let rows = runner::accuracy::measure(&runner::Backend::Cpu, &env, &methods, &points).unwrap();
+    let rows = splitsum_report::accuracy::measure(&splitsum::Backend::Cpu, &env, &methods, &points).unwrap();
     let worst = |pred: &dyn Fn(&str) -> bool| rows.iter().filter(|r| pred(&r.product)).map(|r| r.max_error).fold(0.0f64, f64::max);
     let bake = worst(&|p| p.ends_with("(a) bake"));
     let lookup = worst(&|p| p.starts_with("prefiltered lookup"));

@@ -3,8 +3,8 @@
 //! be finite; the BRDF table stays within [0, 1]; a constant environment stays constant.
 //! `docs/HAZARDS.md` lists each hazard with the rule the code applies.
 
-use runner::Backend;
-use runner::texture::Cube;
+use splitsum::Backend;
+use splitsum::texture::Cube;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::glam::{Vec3, Vec4};
 use splitsum_shaders::kernels::{ProbeParams, probe_mode};
@@ -19,7 +19,7 @@ fn backends() -> [&'static Backend; 2] {
 }
 
 fn params(mode: u32, samples: u32) -> ProbeParams {
-    ProbeParams { mode, count: 0, probe_offset: 0, samples, src_size: 0, src_levels: 0, src_level: 0, lod_bias: 1.0, start: 0, chunk: 0, pad0: 0, pad1: 0 }
+    ProbeParams { mode, count: 0, probe_offset: 0, samples, src_size: 0, src_levels: 0, src_level: 0, lod_bias: 1.0, start: 0, chunk: 0 }
 }
 
 /// Directions where cube and sphere parametrisations break: poles, face centres, edges,
@@ -153,8 +153,9 @@ fn shading_is_finite_at_the_extremes() {
 /// 10²⁰, every product finite, and the GPU's frame finite too.
 #[test]
 fn extreme_environment_bakes_and_renders_finite() {
-    use runner::bake::{self, Products, Settings};
-    use runner::environment::{self, Environment};
+    use splitsum::bake;
+    use splitsum::environment::{self, Environment};
+    use splitsum::settings::{Products, Settings};
     let (w, h) = (64u32, 32u32);
     let mut texels: Vec<Vec4> = (0..w * h).map(|i| Vec4::splat(1.0 + (i % 7) as f32)).collect();
     texels[5] = Vec4::new(f32::MAX, f32::MAX, f32::MAX, 1.0);
@@ -164,7 +165,7 @@ fn extreme_environment_bakes_and_renders_finite() {
     let report = environment::clean(std::path::Path::new("extreme"), &mut texels, true).unwrap();
     assert_eq!(report.clamped, 2, "f32::MAX and +∞ (made the channel's largest finite value) are clamped");
     assert!(texels.iter().all(|t| t.max_element() <= MAX_RADIANCE));
-    let env = Environment::Equirect(runner::texture::Equirect { width: w, height: h, texels });
+    let env = Environment::Equirect(splitsum::texture::Equirect { width: w, height: h, texels });
     let settings = Settings {
         size: 8,
         source_size: 16,
@@ -189,8 +190,8 @@ fn extreme_environment_bakes_and_renders_finite() {
     // Rendered on the GPU in linear radiance, with lights of 10⁶ and mirror spheres.
     let baked = bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();
     let Backend::Gpu(gpu) = support::gpu() else { unreachable!() };
-    let scene = runner::render::GpuScene::new(gpu, &baked);
-    let mut view = runner::render::ViewState::default();
+    let scene = splitsum_display::render::GpuScene::new(gpu, &baked);
+    let mut view = splitsum_display::render::ViewState::default();
     for l in &mut view.lights {
         l.radiance = Vec4::new(1e6, 1e6, 1e6, 0.0);
     }
@@ -198,7 +199,7 @@ fn extreme_environment_bakes_and_renders_finite() {
     frame.flags.x |= splitsum_shaders::scene::Frame::LINEAR;
     let g = scene.render_offscreen(gpu, &frame, None).unwrap();
     assert!(g.iter().all(|p| p.is_finite()), "non-finite pixel on the GPU");
-    let c = runner::render::render_cpu(&baked, &frame);
+    let c = splitsum_display::render::render_cpu(&baked, &frame);
     assert!(c.iter().all(|p| p.is_finite()), "non-finite pixel on the CPU");
 }
 

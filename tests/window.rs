@@ -1,7 +1,7 @@
 //! A windowed smoke test: the viewer opens a real window on an X server (Xvfb, with
 //! lavapipe presenting), and a screenshot of the screen shows the rendered scene.
 
-use runner::render::{GpuScene, ViewState};
+use splitsum_display::render::{GpuScene, ViewState};
 use std::process::{Child, Command};
 use std::sync::{Arc, Mutex};
 
@@ -71,7 +71,7 @@ fn the_viewer_window_shows_the_scene() {
     let shot: Arc<Mutex<Option<(u32, u32, Vec<[u8; 3]>)>>> = Arc::default();
     let sink = shot.clone();
     let shot_display = display.clone();
-    let options = runner::view::ViewOptions {
+    let options = splitsum_display::view::ViewOptions {
         exit_after: Some(std::time::Duration::from_secs(60)),
         exit_after_frames: Some(3),
         on_presented: Some(Box::new(move |frame| {
@@ -81,13 +81,13 @@ fn the_viewer_window_shows_the_scene() {
         })),
         size: (w, h),
     };
-    let gpu = runner::gpu::Gpu::new().expect("a Vulkan adapter (lavapipe)");
-    runner::view::run(gpu, &baked, None, state.clone(), options).expect("the viewer ran");
+    let gpu = splitsum::backend::Gpu::new().expect("a Vulkan adapter (lavapipe)");
+    splitsum_display::view::run(gpu, &baked, None, state.clone(), options).expect("the viewer ran");
     let (sw, _sh, pixels) = shot.lock().unwrap().take().expect("a screenshot was taken");
 
     // The window (at the origin: Xvfb has no window manager) against the same frame
     // rendered offscreen.
-    let gpu = runner::gpu::Gpu::new().unwrap();
+    let gpu = splitsum::backend::Gpu::new().unwrap();
     let scene = GpuScene::new(&gpu, &baked);
     let want = scene.render_offscreen(&gpu, &state.frame(scene.shape, w, h, true), None).unwrap();
     let mut sum = 0.0f64;
@@ -105,7 +105,7 @@ fn the_viewer_window_shows_the_scene() {
     let mean = sum / (3 * w * h) as f64;
     let png = std::env::temp_dir().join("splitsum-window-screenshot.png");
     let rgb: Vec<u8> = (0..h).flat_map(|y| (0..w).map(move |x| (y * sw + x) as usize)).flat_map(|i| pixels[i]).collect();
-    runner::files::write_png(&png, w, h, &rgb).unwrap();
+    splitsum::files::write_png(&png, w, h, &rgb).unwrap();
     println!("window screenshot ({}): mean |Δ| vs offscreen render {mean:.4}, {:.0} % of pixels lit", png.display(), 100.0 * lit as f64 / (w * h) as f64);
     assert!(lit as f64 > 0.9 * (w * h) as f64, "the window is mostly black");
     // 8-bit quantisation and the swapchain's format conversion: well under 1 %.

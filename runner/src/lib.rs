@@ -1,32 +1,13 @@
 //! # runner
 //!
-//! The host side of splitsum: backends (wgpu GPU and native CPU) that run the
-//! `splitsum_shaders` functions, the files that go in and out, and the orchestration of
-//! bakes. It holds no BRDF or sampling math: that lives once, in `splitsum_shaders`.
+//! The `runner` command line: a thin client of `splitsum` (the bake), `splitsum-display`
+//! (scenes, plans, rendering, the viewer) and `splitsum-report` (accuracy against run
+//! time), one module per subcommand under [`cli`]. It maps the library's errors to the
+//! flags a user wrote.
 
-pub mod accuracy;
-pub mod backend;
-pub mod bake;
-pub mod cache;
 pub mod cli;
-pub mod cpu;
-pub mod environment;
-pub mod error;
-pub mod files;
-pub mod gpu;
-pub mod ktx2;
-pub mod measurement;
-pub mod model;
-pub mod plan;
-pub mod plot;
-pub mod preview;
-pub mod progress;
-pub mod raster;
-pub mod render;
-pub mod report;
-pub mod scene;
-pub mod texture;
-pub mod view;
 
-pub use backend::{Backend, BackendKind};
-pub use error::{Error, Result};
+// The crates the subcommands call, under short names.
+use splitsum::{Backend, BackendKind, Error, bake, cache, cost, environment, files, ktx2, output, progress, settings};
+use splitsum_display::{model, plan, prepare, raster, render, scene, view};
+use splitsum_report::report;

@@ -12,13 +12,10 @@
 use crate::brdf::microfacet::Masking;
 use crate::cubemap::{self, CubeLayout};
 use crate::math::MeanPartial;
-use crate::{equirect, irradiance, lut, prefilter};
+use crate::{equirect, half, irradiance, lut, prefilter};
 use bytemuck::{Pod, Zeroable};
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
-
-/// Workgroup width and height of the texel kernels.
-pub const TILE: u32 = 8;
 
 /// Parameters of [`brdf_lut`].
 #[derive(Copy, Clone, Debug, Pod, Zeroable)]
@@ -34,12 +31,6 @@ pub struct LutParams {
     pub start: u32,
     /// Samples in this chunk (at most `math::CHUNK`).
     pub count: u32,
-    /// Unused; keeps the block a multiple of 16 bytes.
-    pub pad0: u32,
-    /// Unused.
-    pub pad1: u32,
-    /// Unused.
-    pub pad2: u32,
 }
 
 /// One chunk of one texel of the split-sum BRDF table: adds samples `start..start+count`
@@ -69,8 +60,6 @@ pub struct TableParams {
     pub masking: u32,
     /// First row of this dispatch.
     pub row_offset: u32,
-    /// Unused; keeps the block 16 bytes.
-    pub pad: u32,
 }
 
 /// One texel of the split-sum BRDF table by deterministic quadrature
@@ -104,10 +93,6 @@ pub struct EquirectParams {
     pub levels: u32,
     /// The pyramid level written (by [`equirect_pyramid`]).
     pub level: u32,
-    /// Unused; keeps the block a multiple of 16 bytes.
-    pub pad0: u32,
-    /// Unused.
-    pub pad1: u32,
 }
 
 /// One texel of level `level` of the equirect's row pyramid, from level `level − 1` of the
@@ -150,8 +135,6 @@ pub struct DownsampleParams {
     pub levels: u32,
     /// The level read; `level + 1` is written.
     pub level: u32,
-    /// Unused; keeps the block 16 bytes.
-    pub pad: u32,
 }
 
 /// One texel of level `level + 1` of a cube, from level `level` of the same buffer.
@@ -194,10 +177,6 @@ pub struct PrefilterParams {
     /// The source level summed exactly (`prefilter::exact_accumulate`), or
     /// `prefilter::SAMPLED`.
     pub exact_level: u32,
-    /// Unused.
-    pub pad1: u32,
-    /// Unused.
-    pub pad2: u32,
 }
 
 /// Reads the three `Vec4` of a [`MeanPartial`] at `accum[3i..]`.
@@ -255,10 +234,6 @@ pub struct IrradianceParams {
     pub start: u32,
     /// Source texels in this chunk (at most `math::CHUNK`).
     pub count: u32,
-    /// Unused; keeps the block a multiple of 16 bytes.
-    pub pad0: u32,
-    /// Unused.
-    pub pad1: u32,
 }
 
 /// One chunk of source texels for one texel of the irradiance cube: adds them to its
@@ -338,10 +313,6 @@ pub struct ProbeParams {
     pub start: u32,
     /// Samples (or texels) in this chunk.
     pub chunk: u32,
-    /// Unused; keeps the block a multiple of 16 bytes.
-    pub pad0: u32,
-    /// Unused.
-    pub pad1: u32,
 }
 
 /// One chunk of probe `q`: the math at an arbitrary input, so that tests run the same
@@ -373,5 +344,128 @@ pub fn probe(
     if id.x < p.count {
         let q = input[(p.probe_offset + id.x) as usize];
         probe_chunk(p, input, q, out, id.x as usize);
+    }
+}
+
+/// Parameters of [`resolve_means`] and [`resolve_lut`].
+#[derive(Copy, Clone, Debug, Pod, Zeroable)]
+#[repr(C)]
+pub struct ResolveParams {
+    /// Texels resolved.
+    pub count: u32,
+    /// Index of the first texel's partial sums in the input (in texels).
+    pub src_offset: u32,
+    /// Index of the first texel written.
+    pub dst_offset: u32,
+    /// Samples per texel, in all (for [`resolve_lut`]).
+    pub samples: u32,
+}
+
+/// The mean of texel `id.x` from its partial sums (`MeanPartial::resolve`, the function
+/// the CPU backend ends with), so that the products stay on the GPU.
+#[spirv(compute(threads(64)))]
+pub fn resolve_means(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &ResolveParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] accum: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+) {
+    if id.x < p.count {
+        out[(p.dst_offset + id.x) as usize] = load_partial(accum, (p.src_offset + id.x) as usize).resolve();
+    }
+}
+
+/// Texel `id.x` of the sampled BRDF table from its sums (`lut::resolve`): `(A, B)` in `xy`.
+#[spirv(compute(threads(64)))]
+pub fn resolve_lut(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &ResolveParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] accum: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+) {
+    if id.x < p.count {
+        let t = lut::resolve(accum[(p.src_offset + id.x) as usize], p.samples);
+        out[(p.dst_offset + id.x) as usize] = Vec4::new(t.x, t.y, 0.0, 0.0);
+    }
+}
+
+/// One texel of a mirror level (roughness 0) of the specular cube: the source read along
+/// the texel's direction (`prefilter::prefilter_texel`, no sum), written at `dst_offset`.
+#[spirv(compute(threads(8, 8)))]
+pub fn prefilter_mirror(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &PrefilterParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+) {
+    let s = p.dst_size;
+    if id.x < s && id.y < s && id.z < cubemap::FACES {
+        let layout = CubeLayout::new(p.src_size, p.src_levels);
+        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
+        out[i] = prefilter::prefilter_texel(src, layout, id.z, id.x, id.y, s, p.roughness, p.samples, p.lod_bias, prefilter::SAMPLED);
+    }
+}
+
+/// Parameters of [`pack_half`] and [`unpack_rows`]: a block of `rows` rows of `width`
+/// texels, dense on the `Vec4` side and `row_words` 32-bit words apart on the packed side
+/// (rows of a texture copy are 256-byte aligned).
+#[derive(Copy, Clone, Debug, Pod, Zeroable)]
+#[repr(C)]
+pub struct RowsParams {
+    /// Texels per row.
+    pub width: u32,
+    /// Rows.
+    pub rows: u32,
+    /// Index of the first `Vec4` texel.
+    pub texel_offset: u32,
+    /// Words from one packed row to the next.
+    pub row_words: u32,
+    /// Index of the first packed word.
+    pub word_offset: u32,
+    /// Channels per packed texel: 4 (RGBA) or 2 (RG).
+    pub channels: u32,
+    /// Packed texels are halves (1) or f32 (0) (for [`unpack_rows`]).
+    pub half: u32,
+}
+
+/// Texel `(id.x, id.y)` as halves (`half::pack_radiance`: NaN to 0, clamped to ±65504),
+/// into rows laid out as `copy_buffer_to_texture` reads them.
+#[spirv(compute(threads(8, 8)))]
+pub fn pack_half(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &RowsParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] texels: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] words: &mut [u32],
+) {
+    if id.x < p.width && id.y < p.rows {
+        let v = texels[(p.texel_offset + id.y * p.width + id.x) as usize];
+        let w = (p.word_offset + id.y * p.row_words + id.x * p.channels / 2) as usize;
+        words[w] = half::pack_radiance(v.x, v.y);
+        if p.channels == 4 {
+            words[w + 1] = half::pack_radiance(v.z, v.w);
+        }
+    }
+}
+
+/// Texel `(id.x, id.y)` of RGBA rows copied out of a caller's texture (halves or f32),
+/// cleaned (`half::clean_radiance`) into dense `Vec4` texels.
+#[spirv(compute(threads(8, 8)))]
+pub fn unpack_rows(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &RowsParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] words: &[u32],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] texels: &mut [Vec4],
+) {
+    if id.x < p.width && id.y < p.rows {
+        let row = (p.word_offset + id.y * p.row_words) as usize;
+        let v = if p.half == 1 {
+            let w = row + 2 * id.x as usize;
+            let (a, b) = (words[w], words[w + 1]);
+            Vec4::new(half::f16_bits_to_f32(a & 0xffff), half::f16_bits_to_f32(a >> 16), half::f16_bits_to_f32(b & 0xffff), half::f16_bits_to_f32(b >> 16))
+        } else {
+            let w = row + 4 * id.x as usize;
+            Vec4::new(f32::from_bits(words[w]), f32::from_bits(words[w + 1]), f32::from_bits(words[w + 2]), f32::from_bits(words[w + 3]))
+        };
+        texels[(p.texel_offset + id.y * p.width + id.x) as usize] = half::clean_radiance(v);
     }
 }

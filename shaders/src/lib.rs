@@ -14,9 +14,11 @@
 #![no_std]
 
 pub mod brdf;
+pub mod choice;
 pub mod cubemap;
 pub mod display;
 pub mod equirect;
+pub mod half;
 pub mod irradiance;
 pub mod kernels;
 pub mod lut;

@@ -180,21 +180,22 @@ pub fn accumulate(
     MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
 }
 
-/// At roughness 0 (a mirror) texel `(x, y)` of `face` of a `dst_size`-wide level is the
-/// texel of the source level of that size, bit for bit, if the source has one.
-pub fn mirror_texel(src: &[Vec4], layout: CubeLayout, face: u32, x: u32, y: u32, dst_size: u32) -> Option<Vec4> {
+/// At roughness 0 (a mirror) a `dst_size`-wide level is the source level of that size, bit
+/// for bit: its index, or [`SAMPLED`] if the source has no level of that size. (An index,
+/// not an `Option<Vec4>`: rust-gpu cannot lower the latter's niche constant.)
+pub fn mirror_level(layout: CubeLayout, dst_size: u32) -> u32 {
     let mut level = 0;
     while level < layout.levels {
         if layout.level_size(level) == dst_size {
-            return Some(src[layout.index(level, face, x, y) as usize]);
+            return level;
         }
         level += 1;
     }
-    None
+    SAMPLED
 }
 
 /// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`: the source
-/// texel itself at roughness 0 ([`mirror_texel`]), the exact sum over source level
+/// texel itself at roughness 0 ([`mirror_level`]), the exact sum over source level
 /// `exact_level` ([`exact_dir`]) unless that is [`SAMPLED`], else [`prefilter_dir`] at the
 /// texel centre.
 #[allow(clippy::too_many_arguments)]
@@ -211,8 +212,9 @@ pub fn prefilter_texel(
     exact_level: u32,
 ) -> Vec4 {
     if roughness <= 0.0 {
-        if let Some(t) = mirror_texel(src, layout, face, x, y, dst_size) {
-            return t;
+        let level = mirror_level(layout, dst_size);
+        if level != SAMPLED {
+            return src[layout.index(level, face, x, y) as usize];
         }
     }
     let n = cubemap::texel_dir(face, x, y, dst_size);

@@ -7,7 +7,7 @@ pub mod model;
 pub use splitsum_reference as reference;
 pub use splitsum_reference::quadrature;
 
-use runner::{Backend, BackendKind};
+use splitsum::{Backend, BackendKind};
 use std::sync::OnceLock;
 
 /// The GPU backend (lavapipe in CI), opened once. Panics with the runner's own message,
@@ -63,16 +63,16 @@ pub fn max_diffs(a: impl IntoIterator<Item = f32>, b: impl IntoIterator<Item = f
 }
 
 /// One of the vendored CC0 environments (`assets/environments/NAME.exr`), as an equirect.
-pub fn environment(name: &str) -> runner::texture::Equirect {
+pub fn environment(name: &str) -> splitsum::texture::Equirect {
     let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/environments").join(format!("{name}.exr"));
-    match runner::environment::load(&path, false).expect("vendored environment") {
-        (runner::environment::Environment::Equirect(e), _) => e,
+    match splitsum::environment::load(&path, false).expect("vendored environment") {
+        (splitsum::environment::Environment::Equirect(e), _) => e,
         _ => unreachable!(),
     }
 }
 
 /// The source cube (with mips) of a vendored environment at face size `size`, on the CPU.
-pub fn source_cube(name: &str, size: u32) -> runner::texture::Cube {
+pub fn source_cube(name: &str, size: u32) -> splitsum::texture::Cube {
     let e = environment(name);
     let n = splitsum_shaders::equirect::supersampling(size, e.width, 2.0);
     Backend::Cpu.equirect_to_cube(&e, size, n).expect("cpu bake")
@@ -80,8 +80,8 @@ pub fn source_cube(name: &str, size: u32) -> runner::texture::Cube {
 
 /// A small, quick bake of the courtyard for the display tests (32² specular cube with 4
 /// mips at 64 samples, 8² irradiance, 32² table), on the CPU.
-pub fn small_display_bake() -> runner::render::BakedEnvironment {
-    let settings = runner::bake::Settings {
+pub fn small_display_bake() -> splitsum::bake::BakedEnvironment {
+    let settings = splitsum::settings::Settings {
         size: 32,
         source_size: 64,
         mips: 4,
@@ -91,14 +91,14 @@ pub fn small_display_bake() -> runner::render::BakedEnvironment {
         sh_source: 16,
         lut_size: 32,
         lut_samples: 64,
-        ..runner::bake::Settings::default()
+        ..splitsum::settings::Settings::default()
     };
-    let env = runner::environment::Environment::Equirect(environment("courtyard"));
-    runner::bake::bake_for_display(&Backend::Cpu, &env, &settings).expect("cpu bake")
+    let env = splitsum::environment::Environment::Equirect(environment("courtyard"));
+    splitsum::bake::bake_for_display(&Backend::Cpu, &env, &settings).expect("cpu bake")
 }
 
 /// A cube with full mips whose level 0 is `f(direction)` at the texel centres.
-pub fn cube_from_fn(size: u32, f: impl Fn(splitsum_shaders::glam::Vec3) -> splitsum_shaders::glam::Vec4) -> runner::texture::Cube {
+pub fn cube_from_fn(size: u32, f: impl Fn(splitsum_shaders::glam::Vec3) -> splitsum_shaders::glam::Vec4) -> splitsum::texture::Cube {
     use splitsum_shaders::cubemap::{self, CubeLayout};
     let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
     let mut texels = vec![splitsum_shaders::glam::Vec4::ZERO; layout.texel_count() as usize];
@@ -109,7 +109,7 @@ pub fn cube_from_fn(size: u32, f: impl Fn(splitsum_shaders::glam::Vec3) -> split
             }
         }
     }
-    let mut cube = runner::texture::Cube { layout, texels };
+    let mut cube = splitsum::texture::Cube { layout, texels };
     Backend::Cpu.build_mips(&mut cube).expect("mips");
     cube
 }

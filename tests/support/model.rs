@@ -226,7 +226,7 @@ pub fn draco_glb(stream: &[u8], ids: [(&str, u32, &str); 3], count: usize, faces
 /// UVs, as a `KHR_draco_mesh_compression` GLB.
 pub fn draco_torus_glb(speed: i32) -> Vec<u8> {
     use draco_core::{DataType, EncoderBuffer, EncoderOptions, FaceIndex, GeometryAttributeType, Mesh, MeshEncoder, PointAttribute};
-    let (doc, buffers, _) = gltf::import_slice(runner::model::EMBEDDED_SAMPLE).unwrap();
+    let (doc, buffers, _) = gltf::import_slice(splitsum_display::model::EMBEDDED_SAMPLE).unwrap();
     let prim = doc.meshes().next().unwrap().primitives().next().unwrap();
     let r = prim.reader(|b| Some(&buffers[b.index()].0[..]));
     let positions: Vec<[f32; 3]> = r.read_positions().unwrap().collect();

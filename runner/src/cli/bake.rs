@@ -1,7 +1,7 @@
 //! `runner bake`: an environment, or a scene's plan, into an output folder.
 
 use super::*;
-use crate::bake;
+use crate::{bake, output};
 
 #[derive(Args)]
 pub(super) struct BakeArgs {
@@ -17,7 +17,7 @@ pub(super) struct BakeArgs {
     #[command(flatten)]
     quality: QualityArgs,
     /// Where to bake.
-    #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "gpu")]
     backend: BackendKind,
     /// Replace NaN and -inf texels by 0 and +inf by the channel's largest finite value
     /// instead of refusing the file.
@@ -42,23 +42,23 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let out = files::OutputDir::begin(&args.out, "--out")?;
     let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
     let backend = Backend::open(args.backend)?;
-    bake::check_bake_duration(&backend, &env, &settings, Products::ALL, &settings.all_levels(), args.scene.force)?;
+    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::ALL, &settings.all_levels()), args.scene.force)?;
     println!("baking {} on {}", env_path.display(), backend.describe());
     let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
-    let manifest = bake::Manifest {
+    let manifest = output::Manifest {
         environment: env_path.display().to_string(),
         backend: backend.describe(),
         settings: settings.clone(),
         roughness_per_mip: settings.roughness(),
         samples_per_mip: settings.samples_per_mip(),
-        accuracy: bake::DEFAULTS_ACCURACY,
+        accuracy: output::DEFAULTS_ACCURACY,
         input: (&input).into(),
         timings: Vec::new(),
         sh9_vs_convolution: None,
         files: Vec::new(),
-        conventions: bake::CONVENTIONS.to_vec(),
+        conventions: output::CONVENTIONS.to_vec(),
     };
-    let manifest = bake::write(out.path(), &baked, &settings, manifest)?;
+    let manifest = output::write(out.path(), &baked, &settings, manifest)?;
     out.commit()?;
     for t in &manifest.timings {
         println!("  {:<12} {:>9.3} s", t.product, t.seconds);
@@ -79,7 +79,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
 /// `plan.json` (decisions, settings, levels, cache key). `specular.ktx2` holds the baked
 /// mips `first ..= last` only (its mip 0 is level `first`; roughness per mip in
 /// `plan.json`; levels in between that the plan skips are zero).
-fn write_scene_bake(out: &files::OutputDir, sb: &bake::SceneBake, format: &Format) -> anyhow::Result<()> {
+fn write_scene_bake(out: &files::OutputDir, sb: &crate::prepare::SceneBake, format: &Format) -> anyhow::Result<()> {
     let dir = out.path();
     let p = &sb.plan;
     let mut written = Vec::new();

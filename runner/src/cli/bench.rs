@@ -10,7 +10,7 @@ pub(super) struct BenchArgs {
     #[command(flatten)]
     quality: QualityArgs,
     /// Backends to time.
-    #[arg(long, value_enum, num_args = 1.., default_values_t = [BackendKind::Gpu, BackendKind::Cpu])]
+    #[arg(long, value_parser = choice::<BackendKind>(), num_args = 1.., default_values = ["gpu", "cpu"])]
     backends: Vec<BackendKind>,
     /// Runs per backend; the table shows the fastest.
     #[arg(long, default_value_t = 1)]
@@ -44,7 +44,7 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 continue;
             }
         };
-        bake::check_bake_duration(&backend, &env, &settings, Products::ALL, &settings.all_levels(), args.force)?;
+        bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::ALL, &settings.all_levels()), args.force)?;
         let mut best: Vec<bake::Timing> = Vec::new();
         for _ in 0..args.runs.max(1) {
             let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;

@@ -1,7 +1,6 @@
 //! `runner lut`: the split-sum BRDF table alone.
 
 use super::*;
-use crate::bake;
 
 #[derive(Args)]
 pub(super) struct LutArgs {
@@ -9,17 +8,17 @@ pub(super) struct LutArgs {
     #[arg(long, default_value_t = 256)]
     size: u32,
     /// Deterministic quadrature (within 1e-5 of the f64 reference) or Hammersley sampling.
-    #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
+    #[arg(long, value_parser = choice::<TableMethod>(), default_value = TableMethod::Quadrature.name())]
     method: TableMethod,
     /// Masking–shadowing term: the exact height-correlated Smith or Smith–Schlick (k = α/2)
     /// [default: correlated; schlick with --method sampled].
-    #[arg(long, value_enum)]
-    masking: Option<MaskingModel>,
+    #[arg(long, value_parser = choice::<Masking>())]
+    masking: Option<Masking>,
     /// Hammersley points per texel (with --method sampled).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1024)]
     samples: u32,
     /// Where to bake.
-    #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "gpu")]
     backend: BackendKind,
     /// Output OpenEXR file (R = scale, G = bias, 32-bit float).
     #[arg(long, default_value = "lut.exr")]
@@ -42,14 +41,20 @@ pub(super) fn lut(args: LutArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     let masking = args.masking.unwrap_or(args.method.default_masking());
     let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: masking, ..Settings::default() };
-    if settings.lut_method == TableMethod::Sampled && settings.lut_masking != MaskingModel::Schlick {
+    if settings.lut_method == TableMethod::Sampled && settings.lut_masking != Masking::SmithSchlick {
         anyhow::bail!("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)");
     }
     // The table is the cost model's third step (`plan::STEPS[2]`); a table needs no source cube.
     let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };
-    let table = crate::plan::step_seconds(&settings, only_table, &[], 0, &crate::plan::Calibration::default(), matches!(backend, Backend::Gpu(_)))[2];
-    bake::check_duration(&[0.0, 0.0, table, 0.0], &["", "", "--size and --samples", ""], args.force)?;
-    let lut = bake::brdf_table(&backend, &settings)?;
+    let table = crate::cost::step_seconds(&settings, only_table, &[], 0, &crate::cost::Calibration::default(), backend.is_gpu())[2];
+    let flags = [("lut_size", "--size"), ("lut_samples", "--samples"), ("lut_method", "--method"), ("lut_masking", "--masking")];
+    let in_flags = |e| in_flags(e, &flags, &["", "", "--size and --samples", ""]);
+    crate::bake::check_duration(&[0.0, 0.0, table, 0.0], args.force).map_err(in_flags)?;
+    let lut = match settings.lut_method {
+        TableMethod::Quadrature => backend.brdf_table(settings.lut_size, settings.lut_masking),
+        TableMethod::Sampled => backend.brdf_lut(settings.lut_size, settings.lut_samples),
+    }
+    .map_err(in_flags)?;
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
     println!("brdf lut {} on {}: bake {:.3} s", settings.table_description(), backend.describe(), secs);

@@ -10,14 +10,17 @@ mod render;
 mod report;
 mod view;
 
-use crate::bake::{Mapping, MaskingModel, Products, Settings, TableMethod};
 use crate::environment;
 use crate::files;
 use crate::ktx2::Format;
 use crate::scene::{DiffuseArg, FresnelArg, SpecularArg, TonemapArg};
+use crate::settings::{Products, Settings, TableMethod};
 use crate::{Backend, BackendKind};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
+use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::choice::Choice;
+use splitsum_shaders::prefilter::RoughnessMapping;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -68,31 +71,31 @@ pub struct SceneArgs {
 }
 
 impl SceneArgs {
-    fn calibration(&self) -> anyhow::Result<crate::plan::Calibration> {
+    fn calibration(&self) -> anyhow::Result<crate::cost::Calibration> {
         match &self.calibration {
-            None => Ok(crate::plan::Calibration::default()),
+            None => Ok(crate::cost::Calibration::default()),
             Some(p) => {
                 let text = std::fs::read_to_string(p).map_err(|e| crate::Error::file(p, format!("cannot read: {e}")))?;
-                crate::plan::Calibration::from_report_csv(&text)
+                crate::cost::Calibration::from_report_csv(&text)
                     .ok_or_else(|| crate::Error::file(p, "is not a report.csv of `runner report` (no brdf lut, prefilter and irradiance rows)").into())
             }
         }
     }
 
     /// Loads the scene, plans it and bakes it (or takes it from the cache), saying which.
-    fn bake(&self, scene_path: &std::path::Path, backend: &Backend) -> anyhow::Result<(crate::scene::Scene, crate::bake::SceneBake)> {
+    fn bake(&self, scene_path: &std::path::Path, backend: &Backend) -> anyhow::Result<(crate::scene::Scene, crate::prepare::SceneBake)> {
         let scene = crate::scene::Scene::load(scene_path)?;
         let cache = crate::cache::Cache::new(self.cache.clone().unwrap_or_else(crate::cache::default_dir));
         let start = Instant::now();
-        let sb = crate::bake::bake_scene(backend, &scene, &self.calibration()?, Some(&cache), self.force)?;
+        let sb = crate::prepare::bake_scene(backend, &scene, &self.calibration()?, Some(&cache), self.force)?;
         let short = &sb.key[..12];
         match &sb.outcome {
-            crate::bake::Outcome::CacheHit => println!("cache hit {short}: nothing to bake ({})", cache.entry(&sb.key).display()),
-            crate::bake::Outcome::Baked => {
+            crate::prepare::Outcome::CacheHit => println!("cache hit {short}: nothing to bake ({})", cache.entry(&sb.key).display()),
+            crate::prepare::Outcome::Baked => {
                 println!("baked {} on {} in {:.2} s; cached as {short}", scene_path.display(), backend.describe(), start.elapsed().as_secs_f64())
             }
-            crate::bake::Outcome::Forced => println!("baked again (--force) in {:.2} s; cached as {short}", start.elapsed().as_secs_f64()),
-            crate::bake::Outcome::Rebuilt(why) => println!("cache entry {short} rejected ({why}); baked again in {:.2} s", start.elapsed().as_secs_f64()),
+            crate::prepare::Outcome::Forced => println!("baked again (--force) in {:.2} s; cached as {short}", start.elapsed().as_secs_f64()),
+            crate::prepare::Outcome::Rebuilt(why) => println!("cache entry {short} rejected ({why}); baked again in {:.2} s", start.elapsed().as_secs_f64()),
         }
         Ok((scene, sb))
     }
@@ -102,13 +105,13 @@ impl SceneArgs {
 #[derive(Args, Clone)]
 pub struct LookArgs {
     /// Diffuse model.
-    #[arg(long, value_enum, default_value_t = DiffuseArg::Lambert)]
+    #[arg(long, value_parser = choice::<DiffuseArg>(), default_value = DiffuseArg::default().name())]
     pub diffuse: DiffuseArg,
     /// Specular model.
-    #[arg(long, value_enum, default_value_t = SpecularArg::CookTorrance)]
+    #[arg(long, value_parser = choice::<SpecularArg>(), default_value = SpecularArg::default().name())]
     pub specular: SpecularArg,
     /// Fresnel form.
-    #[arg(long, value_enum, default_value_t = FresnelArg::Schlick)]
+    #[arg(long, value_parser = choice::<FresnelArg>(), default_value = FresnelArg::default().name())]
     pub fresnel: FresnelArg,
     /// Turn image-based lighting off.
     #[arg(long)]
@@ -120,7 +123,7 @@ pub struct LookArgs {
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
     /// Tone curve.
-    #[arg(long, value_enum, default_value_t = TonemapArg::Aces)]
+    #[arg(long, value_parser = choice::<TonemapArg>(), default_value = TonemapArg::default().name())]
     pub tonemapper: TonemapArg,
     /// Blur of the sky behind the scene, in specular mips (0 = sharp).
     #[arg(long, default_value_t = 0.0)]
@@ -142,14 +145,14 @@ pub struct LookArgs {
     #[arg(long)]
     pub no_grid: bool,
     #[command(flatten)]
-    pub shading: crate::scene::ShadingChoices,
+    pub shading: ShadingFlags,
 }
 
 impl LookArgs {
     /// The view these flags describe, with `auto_exposure` from the environment.
     pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
         use splitsum_shaders::shade::ShadeOptions;
-        let flags = self.shading.flags(!self.no_ibl, !self.no_lights);
+        let flags = self.shading.choices().flags(!self.no_ibl, !self.no_lights);
         let mut view = crate::render::ViewState {
             spheres: !self.no_grid,
             show_model: !self.no_model,
@@ -199,7 +202,7 @@ impl DisplayBakeArgs {
     /// (a quarter of an equirect's width, up to 1024), the rest from the flags.
     pub fn settings(&self, env: &environment::Environment) -> Settings {
         let mips = Settings::default_mips(self.size);
-        let native = crate::plan::native_face_size(env);
+        let native = env.native_face_size();
         Settings { size: self.size, source_size: native.max(self.size), mips, samples: self.samples, lut_size: 128, lut_samples: 512, ..Settings::default() }
     }
 }
@@ -208,7 +211,7 @@ impl DisplayBakeArgs {
 #[derive(Args, Clone)]
 pub struct QualityArgs {
     /// Face size of mip 0 of the specular cube (a power of two).
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = DEFAULT.size)]
     pub size: u32,
     /// Face size of the source cube the products are filtered from [default: --size].
     #[arg(long)]
@@ -217,14 +220,14 @@ pub struct QualityArgs {
     #[arg(long)]
     pub mips: Option<u32>,
     /// How roughness is spread over the mips.
-    #[arg(long, value_enum, default_value_t = Mapping::Geometric)]
-    pub mapping: Mapping,
+    #[arg(long, value_parser = choice::<RoughnessMapping>(), default_value = DEFAULT.mapping.name())]
+    pub mapping: RoughnessMapping,
     /// GGX samples per texel of specular mip 1 (the default, with --sample-growth 2, is the
     /// best end-to-end error per millisecond measured by `runner report` on city.exr).
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 64)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = DEFAULT.samples)]
     pub samples: u32,
     /// Factor by which the sample count grows per mip after mip 1 (1 = the same on every mip).
-    #[arg(long, default_value_t = 2)]
+    #[arg(long, default_value_t = DEFAULT.sample_growth)]
     pub sample_growth: u32,
     /// Sample every mip, even the rough ones that an exact sum over a coarse source level
     /// would bake for less.
@@ -232,13 +235,13 @@ pub struct QualityArgs {
     pub sampled_only: bool,
     /// Bias added to the source mip each prefilter sample reads (0.5: the best error at 1024
     /// samples in `runner report`, on city.exr's sun and on courtyard.exr).
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = DEFAULT.lod_bias, allow_negative_numbers = true)]
     pub lod_bias: f32,
     /// Equirect → cube supersampling: points per source texel width.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = DEFAULT.supersample_density)]
     pub supersample: f32,
     /// Face size of the irradiance cube.
-    #[arg(long, default_value_t = 32)]
+    #[arg(long, default_value_t = DEFAULT.irradiance_size)]
     pub irradiance_size: u32,
     /// Face size of the source mip the irradiance convolution sums over [default: 16, or
     /// the source size if smaller].
@@ -249,20 +252,20 @@ pub struct QualityArgs {
     #[arg(long)]
     pub sh_source: Option<u32>,
     /// Width and height of the BRDF table.
-    #[arg(long, default_value_t = 256)]
+    #[arg(long, default_value_t = DEFAULT.lut_size)]
     pub lut_size: u32,
     /// Samples per texel of the BRDF table (with --lut-method sampled).
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1024)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = DEFAULT.lut_samples)]
     pub lut_samples: u32,
     /// How the BRDF table is integrated: deterministic quadrature (within 1e-5) or sampling.
-    #[arg(long, value_enum, default_value_t = TableMethod::Quadrature)]
+    #[arg(long, value_parser = choice::<TableMethod>(), default_value = DEFAULT.lut_method.name())]
     pub lut_method: TableMethod,
     /// The table's masking–shadowing term.
     /// [default: correlated; schlick with --lut-method sampled]
-    #[arg(long, value_enum)]
-    pub lut_masking: Option<MaskingModel>,
+    #[arg(long, value_parser = choice::<Masking>())]
+    pub lut_masking: Option<Masking>,
     /// KTX2 texel format; auto = RGBA16F unless a value exceeds 65504, then RGBA32F.
-    #[arg(long, value_enum, default_value_t = Format::Auto)]
+    #[arg(long, value_parser = choice::<Format>(), default_value = DEFAULT.format.name())]
     pub format: Format,
 }
 
@@ -293,6 +296,96 @@ impl QualityArgs {
             format: self.format,
         }
     }
+}
+
+/// The one set of defaults, `splitsum::Settings::default()`, as the flags show them.
+static DEFAULT: std::sync::LazyLock<Settings> = std::sync::LazyLock::new(Settings::default);
+
+/// Clap's parser for a [`Choice`]: its names, listed in the help.
+pub(crate) fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(T::ALL.iter().map(|c| c.name())).map(|name| T::from_name(&name).expect("clap accepts only the listed names"))
+}
+
+/// The shading options beside the models (`scene::ShadingChoices`), as flags.
+#[derive(Args, Clone, Copy, Debug, Default)]
+pub struct ShadingFlags {
+    /// Read the prefiltered cube along the mirror direction (the seed's choice) instead of
+    /// the specular dominant direction.
+    #[arg(long)]
+    pub mirror_direction: bool,
+    /// Multiple-scattering energy compensation of the image-based specular (Fdez-Agüera 2019).
+    #[arg(long)]
+    pub multiscatter: bool,
+    /// Quality mode: filtered importance sampling at shading time below mip 1's roughness.
+    #[arg(long)]
+    pub filtered: bool,
+    /// Smith–Schlick (UE4's `k = (r+1)²/8`) for direct lights instead of the exact
+    /// height-correlated Smith term (the image-based light follows the table's own model,
+    /// `--lut-masking`).
+    #[arg(long)]
+    pub smith_schlick: bool,
+}
+
+impl ShadingFlags {
+    /// The choices these flags make.
+    pub fn choices(&self) -> crate::scene::ShadingChoices {
+        crate::scene::ShadingChoices {
+            mirror_direction: self.mirror_direction,
+            multiscatter: self.multiscatter,
+            filtered: self.filtered,
+            smith_schlick: self.smith_schlick,
+        }
+    }
+}
+
+/// The flag of each `Settings` field, for errors in the user's own terms.
+const SETTING_FLAGS: [(&str, &str); 17] = [
+    ("size", "--size"),
+    ("source_size", "--source-size"),
+    ("mips", "--mips"),
+    ("mapping", "--mapping"),
+    ("samples", "--samples"),
+    ("sample_growth", "--sample-growth"),
+    ("exact_sums", "--sampled-only"),
+    ("lod_bias", "--lod-bias"),
+    ("supersample_density", "--supersample"),
+    ("irradiance_size", "--irradiance-size"),
+    ("irradiance_source", "--irradiance-source"),
+    ("sh_source", "--sh-source"),
+    ("lut_size", "--lut-size"),
+    ("lut_samples", "--lut-samples"),
+    ("lut_method", "--lut-method"),
+    ("lut_masking", "--lut-masking"),
+    ("format", "--format"),
+];
+
+/// The flags that set the cost of each of `cost::STEPS`, for a refused long bake.
+const STEP_FLAGS: [&str; 4] =
+    ["--source-size and --supersample", "--samples, --sample-growth and --size", "--lut-size and --lut-samples", "--irradiance-size and --irradiance-source"];
+
+/// A library error in the user's terms: a setting by the flag that sets it (`flags`: field
+/// to flag, beside [`SETTING_FLAGS`]), a refused long bake with the flags that set its cost
+/// and `--force`, unreadable texels with `--sanitize`.
+pub(crate) fn in_flags(e: splitsum::Error, flags: &[(&str, &str)], step_flags: &[&str; 4]) -> anyhow::Error {
+    match e {
+        splitsum::Error::Setting { field, problem } => {
+            let flag = flags.iter().chain(SETTING_FLAGS.iter()).find(|(f, _)| *f == field).map_or(field, |(_, flag)| flag);
+            anyhow::anyhow!("{flag} {problem}")
+        }
+        splitsum::Error::TooLong { step, .. } => {
+            let k = crate::cost::STEPS.iter().position(|s| *s == step).unwrap_or(0);
+            anyhow::anyhow!("{e}; lower {} (scene: [quality]), or pass --force to run it anyway", step_flags[k])
+        }
+        splitsum::Error::NonFinite { .. } => anyhow::anyhow!("{e}: pass --sanitize to do so"),
+        splitsum::Error::NoAdapter { .. } => anyhow::anyhow!("{e}\n  (`--backend cpu` bakes on the CPU)"),
+        e => e.into(),
+    }
+}
+
+/// [`in_flags`] for a bake's flags.
+pub(crate) fn bake_error(e: splitsum::Error) -> anyhow::Error {
+    in_flags(e, &[], &STEP_FLAGS)
 }
 
 /// With `--scene`, the scene file sets everything but where and how to run: refuses any
@@ -335,7 +428,7 @@ where
                 .collect()
         })
         .unwrap_or_default();
-    match cli.command {
+    let result = match cli.command {
         Some(Command::Lut(args)) => lut::lut(args),
         Some(Command::Bake(args)) => bake::bake_command(args, &given),
         Some(Command::Bench(args)) => bench::bench(args),
@@ -344,7 +437,12 @@ where
         Some(Command::Report(args)) => report::report(args),
         Some(Command::Plan(args)) => plan::plan_command(args),
         None => default::default_run(),
-    }
+    };
+    // The library speaks of fields; say the flags the user wrote.
+    result.map_err(|e| match e.downcast::<splitsum::Error>() {
+        Ok(e) => bake_error(e),
+        Err(e) => e,
+    })
 }
 
 /// The peak resident memory of this process in bytes, as the kernel counts it (`VmHWM` in
@@ -399,7 +497,7 @@ pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyho
 /// reference renderer.
 fn render_frame(
     backend: &Backend,
-    env: &crate::render::BakedEnvironment,
+    env: &crate::bake::BakedEnvironment,
     frame: &splitsum_shaders::scene::Frame,
     model: Option<&crate::model::Model>,
 ) -> anyhow::Result<Vec<splitsum_shaders::glam::Vec4>> {

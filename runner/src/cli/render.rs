@@ -19,7 +19,7 @@ pub(super) struct RenderArgs {
     #[arg(long, default_value_t = 540)]
     height: u32,
     /// Bake and render on the GPU, or bake and render on the CPU (the reference renderer).
-    #[arg(long, value_enum, default_value_t = BackendKind::Gpu)]
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "gpu")]
     backend: BackendKind,
     #[command(flatten)]
     look: LookArgs,
@@ -52,7 +52,7 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(args.backend)?;
     let settings = args.bake.settings(&env);
-    bake::check_bake_duration(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &settings.all_levels(), args.scene.force)?;
+    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::DISPLAY, &settings.all_levels()), args.scene.force)?;
     let start = Instant::now();
     let baked = bake::bake_for_display(&backend, &env, &settings)?;
     let bake_secs = start.elapsed().as_secs_f64();

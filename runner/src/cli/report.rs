@@ -13,7 +13,7 @@ pub(super) struct ReportArgs {
     #[arg(long)]
     quick: bool,
     /// Backends to measure (those that cannot be opened are skipped, with a note).
-    #[arg(long, value_enum, num_args = 1.., default_values_t = [BackendKind::Gpu, BackendKind::Cpu])]
+    #[arg(long, value_parser = choice::<BackendKind>(), num_args = 1.., default_values = ["gpu", "cpu"])]
     backends: Vec<BackendKind>,
 }
 

@@ -50,7 +50,7 @@ pub(super) fn view(args: ViewArgs, given: &[String]) -> anyhow::Result<()> {
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(BackendKind::Gpu)?;
     let settings = args.bake.settings(&env);
-    bake::check_bake_duration(&backend, &env, &settings, bake::DISPLAY_PRODUCTS, &settings.all_levels(), args.scene.force)?;
+    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::DISPLAY, &settings.all_levels()), args.scene.force)?;
     let start = Instant::now();
     let baked = bake::bake_for_display(&backend, &env, &settings)?;
     println!("{name} baked on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());

@@ -1,0 +1,77 @@
+//! A scene's bake: its plan ([`crate::plan`]) baked by `splitsum::bake`'s one sequence, or
+//! taken from the cache when an entry for exactly this input, plan, backend and shader
+//! build is there.
+
+use splitsum::Backend;
+use splitsum::bake::{BakedEnvironment, Timing, bake_levels, check_duration, step_estimates};
+use splitsum::error::Result;
+
+/// What happened to a scene's bake.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Found in the cache: nothing baked.
+    CacheHit,
+    /// Baked (and stored, when there is a cache).
+    Baked,
+    /// The cache held an entry that could not be used (why); baked again.
+    Rebuilt(String),
+    /// `--force`: baked again regardless of the cache.
+    Forced,
+}
+
+/// A scene's bake: the plan, the products and how they were obtained.
+pub struct SceneBake {
+    /// The plan.
+    pub plan: crate::plan::Plan,
+    /// The products the display reads (stand-ins for what the plan left out).
+    pub env: BakedEnvironment,
+    /// Cache key.
+    pub key: String,
+    /// Cache hit, baked, or rebuilt.
+    pub outcome: Outcome,
+    /// Wall time per product (empty on a cache hit).
+    pub timings: Vec<Timing>,
+}
+
+/// Bakes what `plan` keeps of `env` into what the display reads (stand-ins for the rest).
+pub fn bake_plan(backend: &Backend, env: &splitsum::Environment, plan: &crate::plan::Plan) -> Result<(BakedEnvironment, Vec<Timing>)> {
+    let baked = bake_levels(backend, env, &plan.settings, plan.products, &plan.levels)?;
+    let timings = baked.timings.clone();
+    Ok((baked.into_display(plan.settings.mapping), timings))
+}
+
+/// Plans `scene` and bakes it, or takes it from `cache` when an entry for exactly this
+/// input, plan, backend and shader build is there (`force` bakes regardless).
+pub fn bake_scene(
+    backend: &Backend,
+    scene: &crate::scene::Scene,
+    cal: &splitsum::cost::Calibration,
+    cache: Option<&splitsum::cache::Cache>,
+    force: bool,
+) -> Result<SceneBake> {
+    let env_path = scene.environment.as_ref().map(|p| scene.resolve(p));
+    let (env, _) = match &env_path {
+        Some(p) => splitsum::environment::load(p, scene.sanitize)?,
+        None => (splitsum::environment::embedded_default()?, Default::default()),
+    };
+    let identity = splitsum::environment::identity(env_path.as_deref())?;
+    let plan = crate::plan::plan_for(scene, &env, cal);
+    let plan_json = serde_json::to_string(&(&plan.settings, &plan.products, &plan.levels, scene.sanitize)).expect("serialisable");
+    let key = splitsum::cache::key(&identity, &plan_json, &backend.identity());
+    let mut outcome = if force { Outcome::Forced } else { Outcome::Baked };
+    // Held until this bake is stored: a concurrent run of the same key waits, then hits.
+    let _lock = cache.map(|c| c.lock(&key)).transpose()?;
+    if let (Some(c), false) = (cache, force) {
+        match c.get(&key) {
+            splitsum::cache::Lookup::Hit(env) => return Ok(SceneBake { plan, env: *env, key, outcome: Outcome::CacheHit, timings: Vec::new() }),
+            splitsum::cache::Lookup::Miss => {}
+            splitsum::cache::Lookup::Rejected(why) => outcome = Outcome::Rebuilt(why),
+        }
+    }
+    check_duration(&step_estimates(backend.is_gpu(), &env, &plan.settings, plan.products, &plan.levels), force)?;
+    let (baked, timings) = bake_plan(backend, &env, &plan)?;
+    if let Some(c) = cache {
+        c.put(&key, &baked)?;
+    }
+    Ok(SceneBake { plan, env: baked, key, outcome, timings })
+}

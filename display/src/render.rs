@@ -1,0 +1,584 @@
+//! Drawing the scene: the view state a user changes (camera, models, exposure…), the frame
+//! block it becomes, the GPU renderer (the `display` shaders on a window or an offscreen
+//! texture) and the CPU reference renderer (the same `scene::pixel`, per pixel, with rayon).
+
+use crate::model::{Model, SLOTS, Texture, Vertex};
+use rayon::prelude::*;
+use splitsum::backend::gpu::{Gpu, group_layout};
+use splitsum::bake::BakedEnvironment;
+use splitsum::error::{Error, Result};
+use splitsum_shaders::glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
+use splitsum_shaders::scene::{self, Frame, Light, MAX_LIGHTS};
+use splitsum_shaders::shade::{EnvironmentShape, ShadeOptions, diffuse_model, fresnel_model, specular_model};
+use splitsum_shaders::tonemap::Tonemapper;
+use splitsum_spirv::{self as spirv, EntryPoint};
+use wgpu::util::DeviceExt;
+
+/// The display's entry points: they share the scene's bind group (1) and the meshes' (2).
+const DISPLAY: [&EntryPoint; 4] = [&spirv::DISPLAY_FULLSCREEN_VS, &spirv::DISPLAY_SCENE_FS, &spirv::DISPLAY_MESH_VS, &spirv::DISPLAY_MESH_FS];
+
+/// Everything a user can change while looking.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewState {
+    /// Orbit angle about the vertical axis, radians.
+    pub yaw: f32,
+    /// Orbit elevation, radians.
+    pub pitch: f32,
+    /// Distance from the target.
+    pub distance: f32,
+    /// The point orbited.
+    pub target: Vec3,
+    /// Vertical field of view, radians.
+    pub fov: f32,
+    /// Exposure multiplier.
+    pub exposure: f32,
+    /// Tone curve.
+    pub tonemapper: Tonemapper,
+    /// Sky blur, in specular mips.
+    pub sky_blur: f32,
+    /// Models and lights.
+    pub options: ShadeOptions,
+    /// Sphere grid rows (metalness) and columns (roughness).
+    pub grid: (u32, u32),
+    /// Draw the sphere grid.
+    pub spheres: bool,
+    /// Draw the model (when there is one).
+    pub show_model: bool,
+    /// Base colour of the spheres.
+    pub base_color: Vec3,
+    /// The grid's metalness range (top to bottom row) and roughness range (left to right).
+    pub grid_ranges: Vec4,
+    /// Direct lights.
+    pub lights: Vec<Light>,
+}
+
+impl Default for ViewState {
+    fn default() -> Self {
+        Self {
+            yaw: 0.0,
+            pitch: 0.0,
+            distance: 8.0,
+            target: Vec3::ZERO,
+            fov: 45f32.to_radians(),
+            exposure: 1.0,
+            tonemapper: Tonemapper::Aces,
+            sky_blur: 0.0,
+            options: ShadeOptions::DEFAULT,
+            grid: (5, 7),
+            spheres: true,
+            show_model: false,
+            base_color: Vec3::new(0.9, 0.45, 0.2),
+            grid_ranges: Vec4::new(0.0, 1.0, 0.0, 1.0),
+            lights: vec![
+                Light { position: Vec4::new(-0.5, 0.8, 0.6, 0.0).normalize() * Vec4::new(1.0, 1.0, 1.0, 0.0), radiance: Vec4::new(3.0, 2.9, 2.7, 0.0) },
+                Light { position: Vec4::new(3.0, 2.0, 4.0, 1.0), radiance: Vec4::new(20.0, 20.0, 24.0, 0.0) },
+            ],
+        }
+    }
+}
+
+/// Names of the models, for titles and reports.
+pub fn diffuse_name(code: u32) -> &'static str {
+    match code {
+        diffuse_model::OREN_NAYAR => "Oren-Nayar",
+        diffuse_model::FRESNEL_WEIGHTED => "Fresnel-weighted",
+        _ => "Lambert",
+    }
+}
+
+/// Name of a specular model.
+pub fn specular_name(code: u32) -> &'static str {
+    match code {
+        specular_model::PHONG => "Phong",
+        specular_model::BLINN_PHONG => "Blinn-Phong",
+        specular_model::NONE => "none",
+        _ => "Cook-Torrance",
+    }
+}
+
+/// Name of a Fresnel form.
+pub fn fresnel_name(code: u32) -> &'static str {
+    if code == fresnel_model::SPHERICAL_GAUSSIAN { "spherical Gaussian" } else { "Schlick" }
+}
+
+/// Name of a tone curve.
+pub fn tonemapper_name(t: Tonemapper) -> &'static str {
+    match t {
+        Tonemapper::Aces => "ACES",
+        Tonemapper::Reinhard => "Reinhard",
+        Tonemapper::Clamp => "clamp",
+    }
+}
+
+impl ViewState {
+    /// Points the camera at what is shown: the grid, the model beside it, or both.
+    pub fn frame_contents(&mut self) {
+        let (centre, size) = crate::model::PLACE_BESIDE_GRID;
+        (self.target, self.distance) = match (self.spheres, self.show_model) {
+            (true, true) => (Vec3::new(0.5 * (centre.x - 3.4), 0.0, 0.0), 11.0),
+            (false, true) => (centre, 2.2 * size),
+            _ => (Vec3::ZERO, 8.0),
+        };
+    }
+
+    /// Camera position.
+    pub fn eye(&self) -> Vec3 {
+        let (sy, cy) = self.yaw.sin_cos();
+        let (sp, cp) = self.pitch.sin_cos();
+        self.target + Vec3::new(cp * sy, sp, cp * cy) * self.distance
+    }
+
+    /// A one-line summary of the choices (the window title).
+    pub fn summary(&self) -> String {
+        /// The image-based light's options, as ` (a, b)`, or nothing.
+        fn ibl_options(flags: u32) -> String {
+            let names: Vec<&str> = [
+                (ShadeOptions::DOMINANT_DIRECTION, "dominant direction"),
+                (ShadeOptions::MULTISCATTER, "multiple scattering"),
+                (ShadeOptions::FILTERED_SAMPLING, "filtered"),
+                (ShadeOptions::CORRELATED_SMITH, "exact Smith for lights"),
+            ]
+            .iter()
+            .filter(|(bit, _)| flags & bit != 0)
+            .map(|&(_, name)| name)
+            .collect();
+            if names.is_empty() { String::new() } else { format!(" ({})", names.join(", ")) }
+        }
+        let o = self.options;
+        format!(
+            "diffuse {} | specular {} | Fresnel {} | IBL {}{} | lights {} | exposure {:.2} | {} | sky blur {:.1}{}",
+            diffuse_name(o.diffuse),
+            specular_name(o.specular),
+            fresnel_name(o.fresnel),
+            if o.flags & ShadeOptions::IBL != 0 { "on" } else { "off" },
+            ibl_options(o.flags),
+            if o.flags & ShadeOptions::DIRECT != 0 { "on" } else { "off" },
+            self.exposure,
+            tonemapper_name(self.tonemapper),
+            self.sky_blur,
+            match (self.spheres, self.show_model) {
+                (true, true) => " | grid + model",
+                (false, true) => " | model",
+                (true, false) => "",
+                (false, false) => " | sky only",
+            }
+        )
+    }
+
+    /// The frame block for a `width`×`height` target. `encode_srgb`: the target stores what
+    /// it is given (a UNORM format), so the shader encodes sRGB itself.
+    pub fn frame(&self, shape: EnvironmentShape, width: u32, height: u32, encode_srgb: bool) -> Frame {
+        let eye = self.eye();
+        let forward = (self.target - eye).normalize();
+        let right = forward.cross(Vec3::Y).try_normalize().unwrap_or(Vec3::X);
+        let up = right.cross(forward);
+        let mut lights = [Light { position: Vec4::ZERO, radiance: Vec4::ZERO }; MAX_LIGHTS];
+        for (slot, l) in lights.iter_mut().zip(&self.lights) {
+            *slot = *l;
+        }
+        let mut flags = 0;
+        if encode_srgb {
+            flags |= Frame::ENCODE_SRGB;
+        }
+        if self.spheres {
+            flags |= Frame::SPHERES;
+        }
+        Frame {
+            eye: eye.extend(1.0),
+            forward: forward.extend((0.5 * self.fov).tan()),
+            right: right.extend(width as f32 / height as f32),
+            up: up.extend(0.0),
+            viewport: Vec4::new(width as f32, height as f32, self.exposure, self.sky_blur),
+            grid: UVec4::new(self.grid.0, self.grid.1, self.tonemapper as u32, self.lights.len().min(MAX_LIGHTS) as u32),
+            flags: UVec4::new(flags, 0, 0, 0),
+            options: self.options,
+            shape,
+            base_color: self.base_color.extend(1.0),
+            lights,
+            view_proj: perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * look_at(eye, forward, right, up),
+            depth_range: Vec4::new(DEPTH_RANGE.0, DEPTH_RANGE.1, 0.0, 0.0),
+            grid_ranges: self.grid_ranges,
+        }
+    }
+}
+
+/// The CPU reference renderer: `scene::pixel` at every pixel centre, row 0 at the top.
+pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
+    let (w, h) = (frame.viewport.x as u32, frame.viewport.y as u32);
+    let mut out = vec![Vec4::ZERO; (w * h) as usize];
+    out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
+        for (x, p) in row.iter_mut().enumerate() {
+            let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            *p = scene::pixel(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, px);
+        }
+    });
+    out
+}
+
+/// The scene pipeline and the baked buffers on the GPU.
+pub struct GpuScene {
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: std::sync::Mutex<Vec<(wgpu::TextureFormat, wgpu::RenderPipeline)>>,
+    frame_buffer: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    /// The shapes of the baked buffers.
+    pub shape: EnvironmentShape,
+}
+
+impl GpuScene {
+    /// Uploads `env` and prepares the bindings.
+    pub fn new(gpu: &Gpu, env: &BakedEnvironment) -> Self {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("scene bindings"), entries: &group_layout(&DISPLAY, 1) });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene layout"),
+            bind_group_layouts: &[None, Some(&layout)],
+            immediate_size: 0,
+        });
+        let frame_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("frame"),
+            size: std::mem::size_of::<Frame>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let specular = gpu.upload_bytes("specular", bytemuck::cast_slice(&env.specular.texels));
+        let irradiance = gpu.upload_bytes("irradiance", bytemuck::cast_slice(&env.irradiance.texels));
+        let lut = gpu.upload_bytes("brdf lut", bytemuck::cast_slice(&env.lut.texels));
+        let source = gpu.upload_bytes("source", bytemuck::cast_slice(&env.source.level(0)));
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("scene"),
+            layout: &layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: frame_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: specular.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: irradiance.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: lut.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: source.as_entire_binding() },
+            ],
+        });
+        Self { layout, pipeline_layout, pipelines: Default::default(), frame_buffer, bind_group, shape: env.shape() }
+    }
+
+    fn pipeline(&self, gpu: &Gpu, format: wgpu::TextureFormat) -> wgpu::RenderPipeline {
+        let mut cache = self.pipelines.lock().expect("pipeline cache");
+        if let Some((_, p)) = cache.iter().find(|(f, _)| *f == format) {
+            return p.clone();
+        }
+        let p = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("scene"),
+            layout: Some(&self.pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &gpu.module,
+                entry_point: Some(spirv::DISPLAY_FULLSCREEN_VS.name),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Always),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &gpu.module,
+                entry_point: Some(spirv::DISPLAY_SCENE_FS.name),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        cache.push((format, p.clone()));
+        p
+    }
+
+    /// Records drawing `frame` into `view` (of `format`) with depth buffer `depth` (of
+    /// [`DEPTH_FORMAT`]): the spheres and sky, then `model` if any.
+    pub fn draw(
+        &self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &wgpu::TextureView,
+        depth: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        frame: &Frame,
+        model: Option<&GpuModel>,
+    ) {
+        gpu.queue.write_buffer(&self.frame_buffer, 0, bytemuck::bytes_of(frame));
+        let pipeline = self.pipeline(gpu, format);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("scene"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(1, &self.bind_group, &[]);
+        pass.draw(0..3, 0..1);
+        if let Some(m) = model {
+            for p in &m.primitives {
+                pass.set_pipeline(&m.pipeline(gpu, self, format, p.double_sided));
+                pass.set_bind_group(1, &self.bind_group, &[]);
+                pass.set_bind_group(2, &p.bind_group, &[]);
+                pass.set_vertex_buffer(0, p.vertices.slice(..));
+                pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..p.count, 0, 0..1);
+            }
+        }
+    }
+
+    /// A depth buffer for a `width`×`height` target.
+    pub fn depth_texture(gpu: &Gpu, width: u32, height: u32) -> wgpu::TextureView {
+        gpu.device
+            .create_texture(&wgpu::TextureDescriptor {
+                label: Some("depth"),
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: DEPTH_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            })
+            .create_view(&Default::default())
+    }
+
+    /// Renders `frame` offscreen into an RGBA32F texture and reads it back (row 0 at the top).
+    pub fn render_offscreen(&self, gpu: &Gpu, frame: &Frame, model: Option<&GpuModel>) -> Result<Vec<Vec4>> {
+        let (w, h) = (frame.viewport.x as u32, frame.viewport.y as u32);
+        let format = wgpu::TextureFormat::Rgba32Float;
+        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("offscreen"),
+            size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let view = texture.create_view(&Default::default());
+        let depth = Self::depth_texture(gpu, w, h);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.draw(gpu, &mut encoder, &view, &depth, format, frame, model);
+        let row = (w as u64 * 16).div_ceil(256) * 256;
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("offscreen readback"),
+            size: row * h as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row as u32), rows_per_image: Some(h) },
+            },
+            wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+        );
+        gpu.queue.submit([encoder.finish()]);
+        let bytes = gpu.read_bytes(&buffer)?;
+        let mut out = Vec::with_capacity((w * h) as usize);
+        for y in 0..h as usize {
+            let start = y * row as usize;
+            out.extend(bytemuck::pod_collect_to_vec::<u8, Vec4>(&bytes[start..start + w as usize * 16]));
+        }
+        Ok(out)
+    }
+}
+
+/// Right-handed perspective projection with depth in [0, 1]: view-space `z = −near` maps
+/// to 0 and `−far` to 1 (the projection `surface::depth` assumes).
+pub fn perspective(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
+    let h = 1.0 / (0.5 * fov_y).tan();
+    let r = far / (near - far);
+    Mat4::from_cols(Vec4::new(h / aspect, 0.0, 0.0, 0.0), Vec4::new(0.0, h, 0.0, 0.0), Vec4::new(0.0, 0.0, r, -1.0), Vec4::new(0.0, 0.0, r * near, 0.0))
+}
+
+/// World to view space for a camera at `eye` with orthonormal `forward`, `right`, `up`.
+pub fn look_at(eye: Vec3, forward: Vec3, right: Vec3, up: Vec3) -> Mat4 {
+    Mat4::from_cols(
+        Vec4::new(right.x, up.x, -forward.x, 0.0),
+        Vec4::new(right.y, up.y, -forward.y, 0.0),
+        Vec4::new(right.z, up.z, -forward.z, 0.0),
+        Vec4::new(-right.dot(eye), -up.dot(eye), forward.dot(eye), 1.0),
+    )
+}
+
+/// Depth buffer format of the display.
+pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+
+/// Near and far planes of the camera.
+pub const DEPTH_RANGE: (f32, f32) = (0.05, 500.0);
+
+/// One primitive of a model on the GPU.
+pub struct GpuPrimitive {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    count: u32,
+    bind_group: wgpu::BindGroup,
+    double_sided: bool,
+}
+
+/// A glTF model on the GPU: buffers, textures (with mipmaps) and the mesh pipelines.
+pub struct GpuModel {
+    primitives: Vec<GpuPrimitive>,
+    pipeline_layout: wgpu::PipelineLayout,
+    pipelines: std::sync::Mutex<Vec<(wgpu::TextureFormat, bool, wgpu::RenderPipeline)>>,
+}
+
+impl GpuModel {
+    /// Uploads `model` for drawing with `scene`.
+    pub fn new(gpu: &Gpu, scene: &GpuScene, model: &Model) -> Self {
+        let device = &gpu.device;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("mesh material"), entries: &group_layout(&DISPLAY, 2) });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("mesh layout"),
+            bind_group_layouts: &[None, Some(&scene.layout), Some(&layout)],
+            immediate_size: 0,
+        });
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("mesh textures"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        let white = Texture { width: 1, height: 1, rgba: vec![255; 4], srgb: false };
+        let primitives = model
+            .primitives
+            .iter()
+            .map(|p| {
+                let uniform = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("mesh material"),
+                    contents: bytemuck::bytes_of(&p.material),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                });
+                let views: Vec<wgpu::TextureView> = p.textures.iter().map(|t| upload_texture(gpu, t.as_ref().unwrap_or(&white))).collect();
+                let mut group = vec![wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }];
+                for (k, v) in views.iter().enumerate() {
+                    group.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: wgpu::BindingResource::TextureView(v) });
+                }
+                group.push(wgpu::BindGroupEntry { binding: SLOTS as u32 + 1, resource: wgpu::BindingResource::Sampler(&sampler) });
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("mesh"), layout: &layout, entries: &group });
+                GpuPrimitive {
+                    vertices: gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("vertices"),
+                        contents: bytemuck::cast_slice(&p.vertices),
+                        usage: wgpu::BufferUsages::VERTEX,
+                    }),
+                    indices: gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                        label: Some("indices"),
+                        contents: bytemuck::cast_slice(&p.indices),
+                        usage: wgpu::BufferUsages::INDEX,
+                    }),
+                    count: p.indices.len() as u32,
+                    bind_group,
+                    double_sided: p.double_sided,
+                }
+            })
+            .collect();
+        Self { primitives, pipeline_layout, pipelines: Default::default() }
+    }
+
+    fn pipeline(&self, gpu: &Gpu, _scene: &GpuScene, format: wgpu::TextureFormat, double_sided: bool) -> wgpu::RenderPipeline {
+        let mut cache = self.pipelines.lock().expect("pipeline cache");
+        if let Some((_, _, p)) = cache.iter().find(|(f, d, _)| *f == format && *d == double_sided) {
+            return p.clone();
+        }
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2];
+        let p = gpu.device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("mesh"),
+            layout: Some(&self.pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &gpu.module,
+                entry_point: Some(spirv::DISPLAY_MESH_VS.name),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: if double_sided { None } else { Some(wgpu::Face::Back) },
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &gpu.module,
+                entry_point: Some(spirv::DISPLAY_MESH_FS.name),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        cache.push((format, double_sided, p.clone()));
+        p
+    }
+}
+
+/// Uploads an RGBA8 texture with its mip chain (box filter; sRGB textures averaged in
+/// linear light) and returns a view of it.
+fn upload_texture(gpu: &Gpu, t: &Texture) -> wgpu::TextureView {
+    let levels = splitsum::texture::mip_chain_rgba8(t.width, t.height, &t.rgba, t.srgb);
+    let format = if t.srgb { wgpu::TextureFormat::Rgba8UnormSrgb } else { wgpu::TextureFormat::Rgba8Unorm };
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("mesh texture"),
+        size: wgpu::Extent3d { width: t.width, height: t.height, depth_or_array_layers: 1 },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (level, (w, h, data)) in levels.iter().enumerate() {
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo { texture: &texture, mip_level: level as u32, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            data,
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(*h) },
+            wgpu::Extent3d { width: *w, height: *h, depth_or_array_layers: 1 },
+        );
+    }
+    texture.create_view(&Default::default())
+}
+
+/// Display values in [0, 1] to 8-bit RGB.
+pub fn to_rgb8(pixels: &[Vec4]) -> Vec<u8> {
+    pixels.iter().flat_map(|p| [p.x, p.y, p.z].map(|v| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)).collect()
+}
+
+/// Checks an output size.
+pub fn check_size(width: u32, height: u32) -> Result<()> {
+    if width == 0 || height == 0 || width > 8192 || height > 8192 {
+        return Err(Error::Invalid(format!("--width and --height must be 1..8192, not {width}×{height}")));
+    }
+    Ok(())
+}

@@ -1,0 +1,634 @@
+//! Scene files (TOML): the environment, materials, objects, lights, camera, output size and
+//! quality target that `runner plan`, `bake --scene`, `view --scene` and `render --scene`
+//! read. Every problem is reported with the file it is in (and the line, for syntax).
+//!
+//! ```toml
+//! environment = "assets/environments/city.exr"   # relative to this file; omit for the embedded one
+//! sky_blur = 0.0                                  # the sky behind the scene, in specular mips
+//!
+//! [output]
+//! width = 1280
+//! height = 720
+//!
+//! [camera]                                        # degrees; distance and target optional
+//! yaw = 20.0
+//! pitch = 10.0
+//! fov = 45.0
+//!
+//! [quality]                                       # every field optional
+//! max_error = 0.02                                # mean error per product: the planner picks the cheapest settings
+//! samples = 1024                                  # or fix them
+//!
+//! [[materials]]
+//! name = "gold"
+//! base_color = [1.0, 0.78, 0.34]
+//! metallic = 1.0                                  # a number, a range [a, b], or "texture"
+//! roughness = [0.3, 0.6]
+//! diffuse = "lambert"                             # lambert | oren-nayar | fresnel-weighted
+//! specular = "cook-torrance"                      # cook-torrance | phong | blinn-phong | none
+//! fresnel = "schlick"                             # schlick | spherical-gaussian
+//! ibl = true
+//!
+//! [[objects]]
+//! kind = "sphere-grid"                            # metalness over the rows, roughness over the columns
+//! material = "gold"
+//!
+//! [[objects]]
+//! kind = "gltf"
+//! path = "assets/models/torus.glb"
+//! material = "gold"                               # models, and ranges the textures are clamped to
+//!
+//! [[lights]]
+//! kind = "directional"
+//! direction = [-0.5, 0.8, 0.6]
+//! radiance = [3.0, 3.0, 3.0]
+//! ```
+
+use serde::{Deserialize, Serialize};
+use splitsum::error::{Error, Result};
+use splitsum_shaders::choice::Choice;
+use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
+use splitsum_shaders::tonemap::Tonemapper;
+use std::path::{Path, PathBuf};
+
+/// Diffuse models.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum DiffuseArg {
+    /// ρ/π.
+    #[default]
+    Lambert,
+    /// Oren–Nayar, σ = roughness.
+    OrenNayar,
+    /// Ashikhmin–Shirley's Fresnel-weighted diffuse.
+    FresnelWeighted,
+}
+
+/// Specular models.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpecularArg {
+    /// GGX, Smith–Schlick, Fresnel.
+    #[default]
+    CookTorrance,
+    /// Normalised Phong.
+    Phong,
+    /// Normalised Blinn–Phong.
+    BlinnPhong,
+    /// No specular.
+    None,
+}
+
+/// Fresnel forms.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum FresnelArg {
+    /// Schlick.
+    #[default]
+    Schlick,
+    /// UE4's spherical Gaussian.
+    SphericalGaussian,
+}
+
+/// Tone curves.
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TonemapArg {
+    /// Narkowicz's ACES fit.
+    #[default]
+    Aces,
+    /// Reinhard.
+    Reinhard,
+    /// Clamp.
+    Clamp,
+}
+
+macro_rules! choices {
+    ($t:ty: $($v:ident => $n:literal),+) => {
+        impl Choice for $t {
+            const ALL: &'static [Self] = &[$(<$t>::$v),+];
+            fn name(self) -> &'static str {
+                match self {
+                    $(<$t>::$v => $n,)+
+                }
+            }
+        }
+    };
+}
+choices!(DiffuseArg: Lambert => "lambert", OrenNayar => "oren-nayar", FresnelWeighted => "fresnel-weighted");
+choices!(SpecularArg: CookTorrance => "cook-torrance", Phong => "phong", BlinnPhong => "blinn-phong", None => "none");
+choices!(FresnelArg: Schlick => "schlick", SphericalGaussian => "spherical-gaussian");
+choices!(TonemapArg: Aces => "aces", Reinhard => "reinhard", Clamp => "clamp");
+
+impl DiffuseArg {
+    /// The shader's code.
+    pub fn code(self) -> u32 {
+        match self {
+            DiffuseArg::Lambert => diffuse_model::LAMBERT,
+            DiffuseArg::OrenNayar => diffuse_model::OREN_NAYAR,
+            DiffuseArg::FresnelWeighted => diffuse_model::FRESNEL_WEIGHTED,
+        }
+    }
+}
+
+impl SpecularArg {
+    /// The shader's code.
+    pub fn code(self) -> u32 {
+        match self {
+            SpecularArg::CookTorrance => specular_model::COOK_TORRANCE,
+            SpecularArg::Phong => specular_model::PHONG,
+            SpecularArg::BlinnPhong => specular_model::BLINN_PHONG,
+            SpecularArg::None => specular_model::NONE,
+        }
+    }
+}
+
+impl FresnelArg {
+    /// The shader's code.
+    pub fn code(self) -> u32 {
+        match self {
+            FresnelArg::Schlick => fresnel_model::SCHLICK,
+            FresnelArg::SphericalGaussian => fresnel_model::SPHERICAL_GAUSSIAN,
+        }
+    }
+}
+
+impl TonemapArg {
+    /// The shader's curve.
+    pub fn curve(self) -> Tonemapper {
+        match self {
+            TonemapArg::Aces => Tonemapper::Aces,
+            TonemapArg::Reinhard => Tonemapper::Reinhard,
+            TonemapArg::Clamp => Tonemapper::Clamp,
+        }
+    }
+}
+
+/// A material parameter: a constant, a range `[a, b]` (the values the material takes
+/// somewhere, e.g. over a sphere grid or a texture), or `"texture"` (anything in [0, 1]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Param {
+    /// One value.
+    Value(f32),
+    /// Every value in `[a, b]`.
+    Range([f32; 2]),
+    /// From a texture: `"texture"`.
+    Texture(String),
+}
+
+impl Param {
+    /// The range of values `[lo, hi]`.
+    pub fn range(&self) -> (f32, f32) {
+        match self {
+            Param::Value(v) => (*v, *v),
+            Param::Range([a, b]) => (*a, *b),
+            Param::Texture(_) => (0.0, 1.0),
+        }
+    }
+}
+
+/// A material.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Its name, for objects to refer to.
+    pub name: String,
+    /// Base colour (linear RGB).
+    #[serde(default = "default_base")]
+    pub base_color: [f32; 3],
+    /// Metalness.
+    #[serde(default = "zero")]
+    pub metallic: Param,
+    /// Perceptual roughness.
+    #[serde(default = "half")]
+    pub roughness: Param,
+    /// Diffuse model.
+    #[serde(default)]
+    pub diffuse: DiffuseArg,
+    /// Specular model.
+    #[serde(default)]
+    pub specular: SpecularArg,
+    /// Fresnel form.
+    #[serde(default)]
+    pub fresnel: FresnelArg,
+    /// Lit by the environment (image-based light).
+    #[serde(default = "yes")]
+    pub ibl: bool,
+    /// Read the prefiltered cube along the mirror direction (see [`ShadingChoices`]).
+    #[serde(default)]
+    pub mirror_direction: bool,
+    /// Multiple-scattering energy compensation.
+    #[serde(default)]
+    pub multiscatter: bool,
+    /// Filtered importance sampling below mip 1's roughness.
+    #[serde(default)]
+    pub filtered: bool,
+    /// Smith–Schlick instead of the exact Smith term for direct lights.
+    #[serde(default)]
+    pub smith_schlick: bool,
+}
+
+/// The shading options a user chooses beside the models, with their defaults: the
+/// prefiltered cube read along the dominant direction, single scattering, no filtered
+/// sampling, the exact Smith term for direct lights. The one place their flags are made.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShadingChoices {
+    /// Read the prefiltered cube along the mirror direction (the seed's choice) instead of
+    /// the specular dominant direction.
+    pub mirror_direction: bool,
+    /// Multiple-scattering energy compensation of the image-based specular (Fdez-Agüera 2019).
+    pub multiscatter: bool,
+    /// Quality mode: filtered importance sampling at shading time below mip 1's roughness.
+    pub filtered: bool,
+    /// Smith–Schlick (UE4's `k = (r+1)²/8`) for direct lights instead of the exact
+    /// height-correlated Smith term (the image-based light follows the table's own model,
+    /// `--lut-masking`).
+    pub smith_schlick: bool,
+}
+
+impl ShadingChoices {
+    /// `ShadeOptions` flags for these choices, with image-based and direct light as given.
+    pub fn flags(&self, ibl: bool, direct: bool) -> u32 {
+        let mut f = 0;
+        let mut set = |on: bool, bit: u32| {
+            if on {
+                f |= bit;
+            }
+        };
+        set(ibl, ShadeOptions::IBL);
+        set(direct, ShadeOptions::DIRECT);
+        set(!self.mirror_direction, ShadeOptions::DOMINANT_DIRECTION);
+        set(self.multiscatter, ShadeOptions::MULTISCATTER);
+        set(self.filtered, ShadeOptions::FILTERED_SAMPLING);
+        set(!self.smith_schlick, ShadeOptions::CORRELATED_SMITH);
+        f
+    }
+}
+
+fn default_base() -> [f32; 3] {
+    [0.9, 0.45, 0.2]
+}
+fn zero() -> Param {
+    Param::Value(0.0)
+}
+fn half() -> Param {
+    Param::Value(0.5)
+}
+fn yes() -> bool {
+    true
+}
+
+impl MaterialSpec {
+    /// The shader options of this material (direct lights on).
+    pub fn options(&self) -> ShadeOptions {
+        ShadeOptions {
+            diffuse: self.diffuse.code(),
+            specular: self.specular.code(),
+            fresnel: self.fresnel.code(),
+            flags: ShadingChoices {
+                mirror_direction: self.mirror_direction,
+                multiscatter: self.multiscatter,
+                filtered: self.filtered,
+                smith_schlick: self.smith_schlick,
+            }
+            .flags(self.ibl, true),
+        }
+    }
+}
+
+/// An object of the scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum ObjectSpec {
+    /// The sphere grid: metalness over the rows, roughness over the columns, in the
+    /// material's ranges.
+    SphereGrid {
+        /// Material name.
+        material: String,
+        /// Rows.
+        #[serde(default = "rows")]
+        rows: u32,
+        /// Columns.
+        #[serde(default = "columns")]
+        columns: u32,
+    },
+    /// A glTF 2.0 model; its roughness and metalness are clamped to the material's ranges.
+    Gltf {
+        /// The `.gltf`/`.glb` file, relative to the scene file.
+        path: PathBuf,
+        /// Material name (models and ranges).
+        material: String,
+    },
+}
+
+fn rows() -> u32 {
+    5
+}
+fn columns() -> u32 {
+    7
+}
+
+impl ObjectSpec {
+    /// The material's name.
+    pub fn material(&self) -> &str {
+        match self {
+            ObjectSpec::SphereGrid { material, .. } | ObjectSpec::Gltf { material, .. } => material,
+        }
+    }
+}
+
+/// A direct light.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum LightSpec {
+    /// A distant light.
+    Directional {
+        /// Towards the light.
+        direction: [f32; 3],
+        /// Radiance arriving.
+        radiance: [f32; 3],
+    },
+    /// A point light.
+    Point {
+        /// Position.
+        position: [f32; 3],
+        /// Radiance at distance 1.
+        intensity: [f32; 3],
+    },
+}
+
+/// The image to produce.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self { width: 960, height: 540 }
+    }
+}
+
+/// The camera, in degrees.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CameraSpec {
+    /// Orbit angle.
+    pub yaw: f32,
+    /// Elevation.
+    pub pitch: f32,
+    /// Vertical field of view.
+    pub fov: f32,
+    /// Distance from the target [default: framing the objects].
+    pub distance: Option<f32>,
+    /// The point looked at [default: framing the objects].
+    pub target: Option<[f32; 3]>,
+}
+
+impl Default for CameraSpec {
+    fn default() -> Self {
+        Self { yaw: 0.0, pitch: 0.0, fov: 45.0, distance: None, target: None }
+    }
+}
+
+/// The quality asked for.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct QualitySpec {
+    /// Largest acceptable mean error per product (relative for radiance, absolute for the
+    /// table): the planner picks the cheapest measured settings that meet it.
+    pub max_error: Option<f64>,
+    /// GGX samples per specular texel.
+    pub samples: Option<u32>,
+    /// Source-mip bias.
+    pub lod_bias: Option<f32>,
+    /// Width of the BRDF table.
+    pub lut_size: Option<u32>,
+    /// Samples per texel of the BRDF table.
+    pub lut_samples: Option<u32>,
+    /// Face size of the source level the irradiance sums over.
+    pub irradiance_source: Option<u32>,
+    /// Face size of mip 0 of the specular cube [default: from the output and the
+    /// smallest roughness].
+    pub size: Option<u32>,
+}
+
+/// How the frame is shown.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DisplaySpec {
+    /// Exposure in stops over the automatic one.
+    pub exposure: f32,
+    /// Tone curve.
+    pub tonemapper: TonemapArg,
+}
+
+/// A scene file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// The environment, relative to the scene file [default: the embedded courtyard].
+    pub environment: Option<PathBuf>,
+    /// Replace NaN/∞ texels instead of refusing the environment.
+    #[serde(default)]
+    pub sanitize: bool,
+    /// Blur of the sky behind the scene, in specular mips (0: the sharp source).
+    #[serde(default)]
+    pub sky_blur: f32,
+    /// The image.
+    #[serde(default)]
+    pub output: OutputSpec,
+    /// The camera.
+    #[serde(default)]
+    pub camera: CameraSpec,
+    /// The quality.
+    #[serde(default)]
+    pub quality: QualitySpec,
+    /// The display transform.
+    #[serde(default)]
+    pub display: DisplaySpec,
+    /// Materials.
+    #[serde(default)]
+    pub materials: Vec<MaterialSpec>,
+    /// Objects.
+    #[serde(default)]
+    pub objects: Vec<ObjectSpec>,
+    /// Direct lights.
+    #[serde(default)]
+    pub lights: Vec<LightSpec>,
+    /// The folder the scene file is in (paths are relative to it).
+    #[serde(skip)]
+    pub dir: PathBuf,
+}
+
+impl Scene {
+    /// Reads and checks a scene file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+        let mut scene = Self::parse(&text).map_err(|e| match e {
+            Error::Invalid(m) => Error::file(path, m),
+            other => other,
+        })?;
+        scene.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok(scene)
+    }
+
+    /// Parses and checks scene text (paths relative to the current folder).
+    pub fn parse(text: &str) -> Result<Self> {
+        let scene: Scene = toml::from_str(text).map_err(|e| Error::Invalid(format!("not a valid scene: {e}")))?;
+        scene.check()?;
+        Ok(scene)
+    }
+
+    fn check(&self) -> Result<()> {
+        let bad = |m: String| Err(Error::Invalid(m));
+        for m in &self.materials {
+            for (what, p) in [("metallic", &m.metallic), ("roughness", &m.roughness)] {
+                if let Param::Texture(t) = p {
+                    if t != "texture" {
+                        return bad(format!("material {:?}: {what} must be a number, [a, b] or \"texture\", not {t:?}", m.name));
+                    }
+                }
+                let (a, b) = p.range();
+                if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a > b {
+                    return bad(format!("material {:?}: {what} range [{a}, {b}] must lie in [0, 1] with a ≤ b", m.name));
+                }
+            }
+        }
+        for o in &self.objects {
+            if !self.materials.iter().any(|m| m.name == o.material()) {
+                return bad(format!("an object uses material {:?}, which no [[materials]] entry defines", o.material()));
+            }
+        }
+        if self.output.width == 0 || self.output.height == 0 || self.output.width > 8192 || self.output.height > 8192 {
+            return bad(format!("[output] must be 1..8192 pixels each way, not {}×{}", self.output.width, self.output.height));
+        }
+        if !(self.camera.fov > 1.0 && self.camera.fov < 170.0) {
+            return bad(format!("[camera] fov must be between 1 and 170 degrees, not {}", self.camera.fov));
+        }
+        if let Some(e) = self.quality.max_error {
+            if !(e > 0.0) {
+                return bad(format!("[quality] max_error must be positive, not {e}"));
+            }
+        }
+        let q = &self.quality;
+        for (field, v) in [("samples", q.samples), ("lut_samples", q.lut_samples)] {
+            if v == Some(0) {
+                return bad(format!("[quality] {field} must be at least 1, not 0"));
+            }
+        }
+        if let Some(v) = q.lut_size.filter(|v| !(1..=splitsum::backend::MAX_LUT_SIZE).contains(v)) {
+            return bad(format!("[quality] lut_size must be from 1 to {}, not {v}", splitsum::backend::MAX_LUT_SIZE));
+        }
+        for (field, v, max) in [("size", q.size, splitsum::settings::MAX_SIZE), ("irradiance_source", q.irradiance_source, 256)] {
+            if let Some(v) = v.filter(|v| !v.is_power_of_two() || *v > max) {
+                return bad(format!("[quality] {field} must be a power of two from 1 to {max}, not {v}"));
+            }
+        }
+        if let Some(b) = q.lod_bias.filter(|b| !(b.is_finite() && (-16.0..=16.0).contains(b))) {
+            return bad(format!("[quality] lod_bias must be within ±16, not {b}"));
+        }
+        Ok(())
+    }
+
+    /// The material called `name`.
+    pub fn material(&self, name: &str) -> &MaterialSpec {
+        self.materials.iter().find(|m| m.name == name).expect("checked when loading")
+    }
+
+    /// The materials objects use, each once, in order.
+    pub fn used_materials(&self) -> Vec<&MaterialSpec> {
+        let mut out: Vec<&MaterialSpec> = Vec::new();
+        for o in &self.objects {
+            let m = self.material(o.material());
+            if !out.iter().any(|x| x.name == m.name) {
+                out.push(m);
+            }
+        }
+        out
+    }
+
+    /// A path of the scene, relative to the scene file.
+    pub fn resolve(&self, p: &Path) -> PathBuf {
+        if p.is_absolute() { p.to_path_buf() } else { self.dir.join(p) }
+    }
+}
+
+impl Scene {
+    /// The view of this scene: camera, direct lights, the sphere grid (the first
+    /// `sphere-grid` object) with its material, exposure and tone curve.
+    pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
+        use splitsum_shaders::glam::{Vec3, Vec4};
+        let grid = self.objects.iter().find_map(|o| match o {
+            ObjectSpec::SphereGrid { material, rows, columns } => Some((self.material(material), *rows, *columns)),
+            ObjectSpec::Gltf { .. } => None,
+        });
+        let model = self.objects.iter().find_map(|o| match o {
+            ObjectSpec::Gltf { material, .. } => Some(self.material(material)),
+            ObjectSpec::SphereGrid { .. } => None,
+        });
+        let mut v = crate::render::ViewState {
+            yaw: self.camera.yaw.to_radians(),
+            pitch: self.camera.pitch.to_radians(),
+            fov: self.camera.fov.to_radians(),
+            exposure: auto_exposure * 2f32.powf(self.display.exposure),
+            tonemapper: self.display.tonemapper.curve(),
+            sky_blur: self.sky_blur,
+            spheres: grid.is_some(),
+            show_model: model.is_some(),
+            lights: self
+                .lights
+                .iter()
+                .map(|l| match l {
+                    LightSpec::Directional { direction, radiance } => splitsum_shaders::scene::Light {
+                        position: Vec3::from(*direction).normalize_or(Vec3::Y).extend(0.0),
+                        radiance: Vec3::from(*radiance).extend(0.0),
+                    },
+                    LightSpec::Point { position, intensity } => {
+                        splitsum_shaders::scene::Light { position: Vec3::from(*position).extend(1.0), radiance: Vec3::from(*intensity).extend(0.0) }
+                    }
+                })
+                .collect(),
+            ..Default::default()
+        };
+        if let Some((m, rows, columns)) = grid {
+            let (m0, m1) = m.metallic.range();
+            let (r0, r1) = m.roughness.range();
+            v.grid = (rows.max(1), columns.max(1));
+            v.grid_ranges = Vec4::new(m0, m1, r0, r1);
+            v.base_color = Vec3::from(m.base_color);
+            v.options = m.options();
+        } else if let Some(m) = model {
+            v.options = m.options();
+        }
+        v.frame_contents();
+        if let Some(d) = self.camera.distance {
+            v.distance = d;
+        }
+        if let Some(t) = self.camera.target {
+            v.target = Vec3::from(t);
+        }
+        v
+    }
+
+    /// The first glTF object's model, with its material's models and ranges, placed beside
+    /// the grid (or where the camera frames it alone).
+    pub fn model(&self) -> Result<Option<crate::model::Model>> {
+        let Some((path, material)) = self.objects.iter().find_map(|o| match o {
+            ObjectSpec::Gltf { path, material } => Some((path, self.material(material))),
+            ObjectSpec::SphereGrid { .. } => None,
+        }) else {
+            return Ok(None);
+        };
+        let mut m = crate::model::load(&self.resolve(path))?;
+        m.set_material(material.options(), material.roughness.range(), material.metallic.range());
+        let (centre, size) = crate::model::PLACE_BESIDE_GRID;
+        m.fit(centre, size);
+        Ok(Some(m))
+    }
+}

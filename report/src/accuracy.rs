@@ -1,0 +1,318 @@
+//! What a renderer shows: the shaded colour of the display's image-based light, end to
+//! end, at any roughness and view, against the full reflectance integral; and the
+//! prefiltered radiance a renderer reads at any roughness, between mips and around the sun.
+//!
+//! **Truth.** The environment is the source cube at the bake's resolution, taken as a
+//! piecewise-constant function (each texel a patch of sphere). The references of
+//! `splitsum_reference::Environment` integrate over it in f64, splitting a texel into
+//! sub-patches wherever the GGX lobe is narrower than the texel. The shaded colour's
+//! truth is the single-scattering GGX microfacet BRDF with the exact (height-correlated)
+//! Smith masking, plus the `(1 − F)`-weighted Lambert diffuse of glTF, integrated with no
+//! split.
+//!
+//! **Points.** Roughness is drawn continuously over `[0.02, 1]` (below 0.02 the lobe is
+//! narrower than the references' finest sub-patch), `n·v` over `(0, 1]`, normals spread
+//! over the sphere (a Hammersley set), plus normals facing the brightest texel (the sun)
+//! and normals whose mirror direction is the sun; metals and dielectrics alternate.
+//!
+//! **Decomposition** of each method's error against the truth:
+//! - (a) *bake*: the display with the baked products against the same display formula fed
+//!   exact ingredients (exact prefiltered radiance along the direction the method reads,
+//!   exact irradiance, exact table): sampling, resolution and mip interpolation;
+//! - (b) *split sum*: that exact-ingredient display against the full integral with the
+//!   method's own masking term: `n = v = r`, the split, the read direction;
+//! - (c) *model*: the full integral with the method's masking term against the truth
+//!   (Smith–Schlick against exact Smith).
+
+use crate::measurement::{Measurement, REL, arr, rel, rel64};
+use rayon::prelude::*;
+use splitsum::backend::Backend;
+use splitsum::bake;
+use splitsum::environment::Environment;
+use splitsum::error::Result;
+use splitsum::settings::{Settings, TableMethod};
+use splitsum::texture::Cube;
+use splitsum_reference as reference;
+use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::glam::{Vec2, Vec3};
+use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_shaders::shade::{self, IblSample, Material, ShadeOptions};
+use splitsum_shaders::{equirect, sampling};
+use std::time::Instant;
+
+/// Roughness bands of the report (lower bounds; the last ends at 1).
+pub const ROUGHNESS_BANDS: [f32; 7] = [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75];
+/// `n·v` bands (upper bounds; the first starts at 0).
+pub const VIEW_BANDS: [f32; 4] = [0.1, 0.3, 0.6, 1.0];
+
+/// Label of the roughness band holding `r`.
+fn roughness_band(r: f32) -> String {
+    let i = ROUGHNESS_BANDS.iter().rposition(|&lo| r >= lo).unwrap_or(0);
+    let hi = ROUGHNESS_BANDS.get(i + 1).copied().unwrap_or(1.0);
+    format!("r in [{}, {}{}", ROUGHNESS_BANDS[i], hi, if i + 1 == ROUGHNESS_BANDS.len() { "]" } else { ")" })
+}
+
+/// Label of the `n·v` band holding `nv`.
+fn view_band(nv: f32) -> String {
+    let i = VIEW_BANDS.iter().position(|&hi| nv <= hi).unwrap_or(VIEW_BANDS.len() - 1);
+    let lo = if i == 0 { 0.0 } else { VIEW_BANDS[i - 1] };
+    format!("n.v in ({lo}, {}]", VIEW_BANDS[i])
+}
+
+/// A display method: bake settings and shading flags.
+#[derive(Clone, Debug)]
+pub struct Method {
+    /// Its name in the report.
+    pub label: String,
+    /// The curve it belongs to on the error-against-time plot (methods that differ only in
+    /// a knob such as the sample count share one).
+    pub family: &'static str,
+    /// How it bakes.
+    pub settings: Settings,
+    /// `ShadeOptions::flags` of its image-based light (`IBL` and options).
+    pub flags: u32,
+}
+
+impl Method {
+    fn options(&self) -> ShadeOptions {
+        ShadeOptions { flags: self.flags | ShadeOptions::IBL, ..ShadeOptions::DEFAULT }
+    }
+}
+
+/// One shading point and its references.
+struct ShadingPoint {
+    material: Material,
+    n: Vec3,
+    v: Vec3,
+    /// Full integral, exact Smith: the truth.
+    truth: [f64; 3],
+    /// Full integral with Smith–Schlick (`k = α/2`).
+    full_schlick: [f64; 3],
+    /// Exact `E/π` along `n`.
+    irradiance: [f64; 3],
+    /// Exact prefiltered radiance along the mirror direction and the dominant direction.
+    prefiltered: [[f64; 3]; 2],
+    /// Exact tables `(A, B)`: Smith–Schlick, exact Smith.
+    table: [Vec2; 2],
+}
+
+/// One lookup of the prefiltered radiance.
+struct LookupPoint {
+    dir: Vec3,
+    roughness: f32,
+    near_sun: bool,
+    exact: [f64; 3],
+}
+
+/// The points and their references, computed once for every method.
+pub struct Points {
+    shading: Vec<ShadingPoint>,
+    lookups: Vec<LookupPoint>,
+}
+
+fn vec(c: [f64; 3]) -> Vec3 {
+    Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)
+}
+
+/// A unit direction spread over the sphere (point `i` of `n` of a Hammersley set through
+/// the equirect map, area-uniform in `cos θ`).
+fn sphere_dir(i: u32, n: u32) -> Vec3 {
+    let p = sampling::hammersley(i, n);
+    // v = acos(1 − 2y)/π makes the set uniform in area.
+    let z = 1.0 - 2.0 * p.y;
+    let v = (z.clamp(-1.0, 1.0)).acos() / std::f32::consts::PI;
+    equirect::uv_to_dir(Vec2::new(p.x, v))
+}
+
+/// Base-3 radical inverse: a third low-discrepancy dimension.
+fn radical3(mut i: u32) -> f32 {
+    let (mut f, mut r) = (1.0f64, 0.0f64);
+    while i > 0 {
+        f /= 3.0;
+        r += f * (i % 3) as f64;
+        i /= 3;
+    }
+    r as f32
+}
+
+/// The golden-ratio sequence `frac(i·φ)`: a low-discrepancy dimension uncorrelated with
+/// the parity of `i` (which picks metal or dielectric, sun or not).
+fn golden(i: u32) -> f32 {
+    ((i as f64 * 0.618_033_988_749_895 + 0.5).fract()) as f32
+}
+
+/// A unit vector perpendicular to `n`, turned by `turn` (in turns) about it.
+fn tangent(n: Vec3, turn: f32) -> Vec3 {
+    let (t, b) = sampling::orthonormal_basis(n);
+    let (s, c) = (turn * std::f32::consts::TAU).sin_cos();
+    t * c + b * s
+}
+
+impl Points {
+    /// `shading` shading points and `lookups` lookups over `source` (its level 0).
+    pub fn new(source: &Cube, shading: u32, lookups: u32) -> Self {
+        let s = source.layout.size;
+        let env = reference::Environment::new(source.level(0), s);
+        let sun = vec(env.brightest()).normalize();
+        let base = Vec3::new(0.9, 0.6, 0.3);
+        let mut pts = Vec::new();
+        for i in 0..shading {
+            let nv = (1.0 - radical3(i + 1)).max(1e-3);
+            let r = 0.02 + 0.98 * golden(i);
+            let turn = sampling::hammersley(i, shading).x;
+            // Every fourth point faces the sun; every fourth (offset by two) mirrors it.
+            let (n, v) = match i % 4 {
+                1 => (sun, (sun * nv + tangent(sun, turn) * (1.0 - nv * nv).sqrt()).normalize()),
+                3 => {
+                    // n halfway between the sun and a view at n·v from it: reflect(v, n) = sun.
+                    let t = tangent(sun, turn);
+                    let theta = nv.acos(); // angle between n and v (and n and sun)
+                    let n = (sun * theta.cos() + t * theta.sin()).normalize();
+                    (n, sampling::reflect(sun, n))
+                }
+                _ => {
+                    let n = sphere_dir(i, shading);
+                    (n, (n * nv + tangent(n, turn) * (1.0 - nv * nv).sqrt()).normalize())
+                }
+            };
+            let material = Material { base_color: base, metallic: (i % 2) as f32, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
+            pts.push((material, n, v));
+        }
+        let shading: Vec<ShadingPoint> = pts
+            .into_par_iter()
+            .map(|(m, n, v)| {
+                let (na, va, b) = (arr(n), arr(v), arr(m.base_color));
+                let r = m.roughness as f64;
+                let refl = sampling::reflect(v, n);
+                let dominant = shade::dominant_direction(n, refl, m.roughness);
+                let nv = n.dot(v).max(shade::MIN_N_DOT_V) as f64;
+                let table = |smith| {
+                    let (a, b) = reference::brdf_lut_with(nv, r, 1e-7, smith);
+                    Vec2::new(a as f32, b as f32)
+                };
+                ShadingPoint {
+                    material: m,
+                    n,
+                    v,
+                    truth: env.shade(na, va, b, m.metallic as f64, r, reference::Smith::Correlated),
+                    full_schlick: env.shade(na, va, b, m.metallic as f64, r, reference::Smith::Schlick),
+                    irradiance: env.integrate(|l| [reference::dot(na, l).max(0.0) / std::f64::consts::PI; 3], |_| f64::INFINITY).0,
+                    prefiltered: [env.prefilter(arr(refl), r), env.prefilter(arr(dominant), r)],
+                    table: [table(reference::Smith::Schlick), table(reference::Smith::Correlated)],
+                }
+            })
+            .collect();
+        // Lookups: half within a few lobe widths of the sun, half anywhere.
+        let look: Vec<(Vec3, f32, bool)> = (0..lookups)
+            .map(|i| {
+                let r = 0.02 + 0.98 * golden(i / 2);
+                let near = i % 2 == 0;
+                let dir = if near {
+                    // Up to three lobe widths (α = r², at least two source texels) from the sun.
+                    let width = (r * r).max(2.0 * std::f32::consts::FRAC_PI_2 / s as f32);
+                    let angle = 3.0 * width * radical3(i + 1);
+                    (sun * angle.cos() + tangent(sun, sampling::hammersley(i, lookups).x) * angle.sin()).normalize()
+                } else {
+                    sphere_dir(i, lookups)
+                };
+                (dir, r, near)
+            })
+            .collect();
+        let lookups = look
+            .into_par_iter()
+            .map(|(dir, roughness, near_sun)| LookupPoint { dir, roughness, near_sun, exact: env.prefilter(arr(dir), roughness as f64) })
+            .collect();
+        Self { shading, lookups }
+    }
+}
+
+/// The settings splitsum's bake used before this measure existed (the seed method): six
+/// mips with roughness `m/5`, 1024 GGX samples per texel at source bias 0.5, the sampled
+/// 1024-point table; mip 0 at the source's size.
+pub fn seed_settings(source_size: u32) -> Settings {
+    Settings {
+        size: source_size,
+        source_size,
+        mips: 6.min(splitsum_shaders::cubemap::CubeLayout::full_chain(source_size)),
+        mapping: RoughnessMapping::Linear,
+        samples: 1024,
+        sample_growth: 1,
+        exact_sums: false,
+        lod_bias: 0.5,
+        lut_method: TableMethod::Sampled,
+        lut_masking: Masking::SmithSchlick,
+        lut_samples: 1024,
+        ..Settings::default()
+    }
+    .fitted()
+}
+
+/// Bakes each method on `backend`, times it and measures it at `points`.
+pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points: &Points) -> Result<Vec<Measurement>> {
+    let b = backend.describe();
+    let mut rows = Vec::new();
+    for method in methods {
+        let start = Instant::now();
+        let baked = bake::bake_for_display(backend, env, &method.settings)?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
+        let opts = method.options();
+        let dominant = usize::from(opts.flags & ShadeOptions::DOMINANT_DIRECTION != 0);
+        let correlated = usize::from(method.settings.lut_masking == Masking::SmithCorrelated);
+        // Per point: (r, n·v, total error, (a), (b), (c)).
+        let per_point: Vec<(f32, f32, f64, f64, f64, f64)> = points
+            .shading
+            .iter()
+            .map(|p| {
+                let m = &p.material;
+                let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, opts.flags, p.n, p.v, m.roughness);
+                let shown = shade::ibl(opts, m, p.n, p.v, s);
+                let exact = IblSample { prefiltered: vec(p.prefiltered[dominant]), irradiance: vec(p.irradiance), brdf: p.table[correlated] };
+                let split = shade::ibl(opts, m, p.n, p.v, exact);
+                let full = if correlated == 1 { p.truth } else { p.full_schlick };
+                (m.roughness, p.n.dot(p.v), rel(shown, p.truth), rel(shown, arr(split)), rel(split, full), rel64(full, p.truth))
+            })
+            .collect();
+        let label = &method.label;
+        let all: Vec<f64> = per_point.iter().map(|p| p.2).collect();
+        rows.push(Measurement::of(format!("shaded colour, end to end: {}", method.family), &b, label.clone(), ms, &all, REL));
+        let mut bands: Vec<(String, Vec<&(f32, f32, f64, f64, f64, f64)>)> = Vec::new();
+        for p in &per_point {
+            for key in [roughness_band(p.0), view_band(p.1)] {
+                match bands.iter_mut().find(|(k, _)| *k == key) {
+                    Some((_, v)) => v.push(p),
+                    None => bands.push((key, vec![p])),
+                }
+            }
+        }
+        bands.sort_by(|a, b| a.0.cmp(&b.0));
+        for (key, pts) in &bands {
+            let col = |f: fn(&(f32, f32, f64, f64, f64, f64)) -> f64| pts.iter().map(|p| f(p)).collect::<Vec<f64>>();
+            rows.push(Measurement::of(format!("shaded colour {key}"), &b, label.clone(), f64::NAN, &col(|p| p.2), REL));
+            rows.push(Measurement::of(format!("shaded colour {key}: (a) bake"), &b, label.clone(), f64::NAN, &col(|p| p.3), REL));
+            rows.push(Measurement::of(format!("shaded colour {key}: (b) split sum"), &b, label.clone(), f64::NAN, &col(|p| p.4), REL));
+            rows.push(Measurement::of(format!("shaded colour {key}: (c) model"), &b, label.clone(), f64::NAN, &col(|p| p.5), REL));
+        }
+        // The prefiltered radiance a renderer reads at any roughness.
+        let lookups: Vec<(f32, bool, f64)> = points
+            .lookups
+            .iter()
+            .map(|q| {
+                let got = shade::prefiltered(shape, &spec.texels, opts.flags, q.dir, q.roughness).truncate();
+                (q.roughness, q.near_sun, rel(got, q.exact))
+            })
+            .collect();
+        let all: Vec<f64> = lookups.iter().map(|l| l.2).collect();
+        rows.push(Measurement::of(format!("prefiltered lookup, any roughness: {}", method.family), &b, label.clone(), ms, &all, REL));
+        for &lo in &ROUGHNESS_BANDS {
+            let band = roughness_band(lo);
+            for (near, place) in [(true, "near the sun"), (false, "anywhere")] {
+                let e: Vec<f64> = lookups.iter().filter(|l| l.1 == near && roughness_band(l.0) == band).map(|l| l.2).collect();
+                if !e.is_empty() {
+                    rows.push(Measurement::of(format!("prefiltered lookup {band} {place}"), &b, label.clone(), f64::NAN, &e, REL));
+                }
+            }
+        }
+    }
+    Ok(rows)
+}

@@ -1,0 +1,81 @@
+//! IEEE 754 binary16 ("half") conversion in integer arithmetic, so that the GPU's texture
+//! packing and the CPU's agree bit for bit (spirv-std's `PackHalf2x16` exists only on the
+//! GPU, and its rounding is implementation-defined).
+//!
+//! f32 → f16 rounds to nearest, ties to even (IEEE 754-2019 §4.3.1): the 23-bit mantissa
+//! keeps its top 10 bits and the 13 dropped bits decide the rounding; below 2⁻¹⁴ the value
+//! becomes a subnormal `m·2⁻²⁴` with `m` the mantissa shifted right by `14 − e`. A carry
+//! out of the mantissa moves into the exponent, which is the correctly rounded result
+//! (up to +∞ past 65504). [`pack_radiance`] clamps first, so radiance never reaches ∞.
+
+use spirv_std::glam::Vec4;
+
+/// The largest finite half float.
+pub const HALF_MAX: f32 = 65504.0;
+
+/// The binary16 bits of `x` (in the low 16 bits), rounded to nearest even.
+#[inline]
+pub fn f32_to_f16_bits(x: f32) -> u32 {
+    let b = x.to_bits();
+    let sign = (b >> 16) & 0x8000;
+    let exp = ((b >> 23) & 0xff) as i32;
+    let man = b & 0x7f_ffff;
+    if exp == 0xff {
+        // ∞ stays ∞; NaN stays a quiet NaN.
+        return sign | 0x7c00 | if man != 0 { 0x200 } else { 0 };
+    }
+    let e = exp - 127 + 15;
+    if e >= 0x1f {
+        return sign | 0x7c00;
+    }
+    if e <= 0 {
+        let shift = (14 - e) as u32;
+        if shift > 24 {
+            return sign;
+        }
+        let full = man | 0x80_0000;
+        let m = full >> shift;
+        let rest = full & ((1u32 << shift) - 1);
+        let half = 1u32 << (shift - 1);
+        let up = rest > half || (rest == half && (m & 1) == 1);
+        return sign | (m + up as u32);
+    }
+    let h = ((e as u32) << 10) | (man >> 13);
+    let rest = man & 0x1fff;
+    let up = rest > 0x1000 || (rest == 0x1000 && (h & 1) == 1);
+    sign | (h + up as u32)
+}
+
+/// The f32 value of the binary16 bits in the low 16 bits of `h` (exact: every half is an
+/// f32).
+#[inline]
+pub fn f16_bits_to_f32(h: u32) -> f32 {
+    let sign = (h & 0x8000) << 16;
+    let exp = (h >> 10) & 0x1f;
+    let man = h & 0x3ff;
+    if exp == 0 {
+        // Zero or subnormal: man·2⁻²⁴, exact in f32.
+        let v = man as f32 * (1.0 / 16_777_216.0);
+        return if sign != 0 { -v } else { v };
+    }
+    let bits = if exp == 31 { sign | 0x7f80_0000 | (man << 13) } else { sign | ((exp + 112) << 23) | (man << 13) };
+    f32::from_bits(bits)
+}
+
+/// Two radiance values packed as halves (`a` in the low 16 bits): NaN becomes 0 and
+/// magnitudes beyond [`HALF_MAX`] become ±`HALF_MAX`, so a sun of 10⁶ stays the brightest
+/// finite value rather than ∞.
+#[inline]
+pub fn pack_radiance(a: f32, b: f32) -> u32 {
+    #[allow(clippy::eq_op)]
+    let c = |x: f32| if x != x { 0.0 } else { crate::math::clamp(x, -HALF_MAX, HALF_MAX) };
+    f32_to_f16_bits(c(a)) | (f32_to_f16_bits(c(b)) << 16)
+}
+
+/// A texel read from a caller's texture, made what the bake takes: NaN and negative
+/// values become 0, values above `math::MAX_RADIANCE` (and +∞) become it.
+#[inline]
+pub fn clean_radiance(v: Vec4) -> Vec4 {
+    let c = |x: f32| if x > 0.0 { if x < crate::math::MAX_RADIANCE { x } else { crate::math::MAX_RADIANCE } } else { 0.0 };
+    Vec4::new(c(v.x), c(v.y), c(v.z), c(v.w))
+}

@@ -1,0 +1,161 @@
+//! The CPU backend: the same `splitsum_shaders` functions the kernels call, run natively
+//! over every texel with rayon, with a progress bar on work that takes a while.
+
+use super::{Kernels, Prefilter, chunks};
+use crate::error::Result;
+use crate::progress::bar as progress;
+use crate::texture::{Equirect, Sh9};
+use indicatif::ProgressBar;
+use rayon::prelude::*;
+use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
+use splitsum_shaders::glam::Vec4;
+use splitsum_shaders::irradiance;
+use splitsum_shaders::kernels::{self, ProbeParams};
+use splitsum_shaders::{equirect, lut, prefilter};
+
+/// The CPU backend (rayon's global thread pool).
+#[derive(Copy, Clone, Debug, Default)]
+pub struct Cpu;
+
+/// A `size`² table with texel `(x, y)` = `f(x, y)` in `xy`.
+fn table(what: &str, size: u32, f: impl Fn(u32, u32) -> Vec4 + Sync) -> Vec<Vec4> {
+    let bar = progress(what, size as u64);
+    let mut texels = vec![Vec4::ZERO; (size * size) as usize];
+    texels.par_chunks_mut(size as usize).enumerate().for_each(|(y, row)| {
+        for (x, t) in row.iter_mut().enumerate() {
+            *t = f(x as u32, y as u32);
+        }
+        bar.inc(1);
+    });
+    bar.finish_and_clear();
+    texels
+}
+
+/// Fills one level (`FACES · size` rows of `size` texels) with `f(face, x, y)`.
+fn fill_level(out: &mut [Vec4], size: u32, bar: &ProgressBar, f: impl Fn(u32, u32, u32) -> Vec4 + Sync) {
+    out.par_chunks_mut(size as usize).enumerate().for_each(|(row, texels)| {
+        let face = row as u32 / size;
+        let y = row as u32 % size;
+        for (x, t) in texels.iter_mut().enumerate() {
+            *t = f(face, x as u32, y);
+        }
+        bar.inc(1);
+    });
+}
+
+/// The row pyramid of `env` (`equirect::pyramid_texel`): level 0 the image, each level
+/// above half as wide.
+pub fn equirect_pyramid(env: &Equirect) -> Vec<Vec4> {
+    let (w, h) = (env.width, env.height);
+    let mut pyramid = env.texels.clone();
+    pyramid.resize(equirect::pyramid_len(w, h) as usize, Vec4::ZERO);
+    for level in 1..equirect::pyramid_levels(w) {
+        let start = equirect::pyramid_offset(level, w, h) as usize;
+        let lw = (w >> level) as usize;
+        let (above, below) = pyramid.split_at_mut(start);
+        let src: &[Vec4] = above;
+        below[..lw * h as usize].par_chunks_mut(lw).enumerate().for_each(|(y, row)| {
+            for (x, t) in row.iter_mut().enumerate() {
+                *t = equirect::pyramid_texel(src, w, h, level, x as u32, y as u32);
+            }
+        });
+    }
+    pyramid
+}
+
+impl Kernels for Cpu {
+    type Texels = Vec<Vec4>;
+
+    fn upload(&self, _what: &str, texels: &[Vec4]) -> Result<Vec<Vec4>> {
+        Ok(texels.to_vec())
+    }
+
+    fn read(&self, texels: &Vec<Vec4>) -> Result<Vec<Vec4>> {
+        Ok(texels.clone())
+    }
+
+    fn slice(&self, texels: &Vec<Vec4>, start: u32, count: u32) -> Result<Vec<Vec4>> {
+        Ok(texels[start as usize..(start + count) as usize].to_vec())
+    }
+
+    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Vec<Vec4>> {
+        let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
+        let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
+        let pyramid = equirect_pyramid(env);
+        let levels = equirect::pyramid_levels(env.width);
+        let bar = progress("equirect", (FACES * size) as u64);
+        let level0 = &mut texels[..(FACES * size * size) as usize];
+        fill_level(level0, size, &bar, |face, x, y| equirect::cube_texel(&pyramid, env.width, env.height, levels, face, x, y, size, supersample));
+        bar.finish_and_clear();
+        self.build_mips(&mut texels, layout)?;
+        Ok(texels)
+    }
+
+    fn build_mips(&self, cube: &mut Vec<Vec4>, layout: CubeLayout) -> Result<()> {
+        for level in 0..layout.levels - 1 {
+            let start = layout.level_offset(level + 1) as usize;
+            let (above, below) = cube.split_at_mut(start);
+            let s = layout.level_size(level + 1);
+            let dst = &mut below[..(FACES * s * s) as usize];
+            let src: &[Vec4] = above;
+            dst.par_chunks_mut(s as usize).enumerate().for_each(|(row, texels)| {
+                let face = row as u32 / s;
+                let y = row as u32 % s;
+                for (x, t) in texels.iter_mut().enumerate() {
+                    *t = cubemap::downsample_texel(src, layout, level, face, x as u32, y);
+                }
+            });
+        }
+        Ok(())
+    }
+
+    fn prefilter(&self, src: &Vec<Vec4>, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Vec<Vec4>> {
+        let out = job.layout;
+        let mut texels = vec![Vec4::ZERO; out.texel_count() as usize];
+        let rows: u64 = job.levels.iter().map(|&m| (FACES * out.level_size(m)) as u64).sum();
+        let bar = progress("specular", rows);
+        for &m in job.levels {
+            let s = out.level_size(m);
+            let start = out.level_offset(m) as usize;
+            let level = &mut texels[start..start + (FACES * s * s) as usize];
+            let (r, n, e) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
+            fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(src, src_layout, face, x, y, s, r, n, job.lod_bias, e));
+        }
+        bar.finish_and_clear();
+        Ok(texels)
+    }
+
+    fn irradiance(&self, src: &Vec<Vec4>, src_layout: CubeLayout, level: u32, size: u32) -> Result<Vec<Vec4>> {
+        let layout = CubeLayout::new(size, 1);
+        let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
+        let bar = progress("irradiance", (FACES * size) as u64);
+        fill_level(&mut texels, size, &bar, |face, x, y| irradiance::convolve_dir(src, src_layout, level, cubemap::texel_dir(face, x, y, size)));
+        bar.finish_and_clear();
+        Ok(texels)
+    }
+
+    fn sh9(&self, src: &Vec<Vec4>, src_layout: CubeLayout, level: u32) -> Result<Sh9> {
+        let s = src_layout.level_size(level);
+        let rows: Vec<_> = (0..FACES * s).into_par_iter().map(|row| irradiance::sh9_row(src, src_layout, level, row / s, row % s)).collect();
+        Ok(Sh9::from_rows(&rows))
+    }
+
+    fn brdf_lut(&self, size: u32, samples: u32) -> Result<Vec<Vec4>> {
+        Ok(table("brdf lut", size, |x, y| lut::texel(x, y, size, samples).extend(0.0).extend(0.0)))
+    }
+
+    fn brdf_table(&self, size: u32, masking: Masking) -> Result<Vec<Vec4>> {
+        Ok(table("brdf table", size, |x, y| lut::texel_quadrature(x, y, size, masking).extend(0.0).extend(0.0)))
+    }
+
+    fn probe_raw(&self, p: ProbeParams, texels: &[Vec4], probes: &[Vec4], terms: u32) -> Result<Vec<Vec4>> {
+        let mut out = vec![Vec4::ZERO; 3 * probes.len()];
+        for (i, &q) in probes.iter().enumerate() {
+            for (start, chunk) in chunks(terms) {
+                kernels::probe_chunk(&ProbeParams { start, chunk, ..p }, texels, q, &mut out, i);
+            }
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,201 @@
+//! A content-addressed cache of bakes: the key is a BLAKE3 hash of the environment's bytes,
+//! every setting of the plan, the backend (and its adapter) and the compiled shaders, so an
+//! unchanged bake is never redone and any change — a byte of the input, a sample count, a
+//! shader edit — makes a new entry.
+//!
+//! An entry is a folder named by its key: `manifest.json` (the key again, and each file's
+//! size and BLAKE3 hash) and one raw little-endian f32 file per product. An entry whose
+//! manifest does not name its own key (foreign), or whose files are missing, short or do
+//! not hash to the manifest (corrupt), is never used: it is removed and rebuilt. Entries
+//! are written to a temporary folder and renamed into place.
+
+use crate::bake::BakedEnvironment;
+use crate::error::{Error, Result};
+use crate::texture::{Cube, Lut};
+use serde::{Deserialize, Serialize};
+use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::glam::{Vec2, Vec4};
+use splitsum_shaders::prefilter::RoughnessMapping;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Version of the entry format (part of every key).
+pub const FORMAT: &str = "splitsum-cache-2";
+
+/// The cache folder: `$SPLITSUM_CACHE`, else `$XDG_CACHE_HOME/splitsum`, else
+/// `~/.cache/splitsum`, else `.splitsum-cache`.
+pub fn default_dir() -> PathBuf {
+    if let Some(d) = std::env::var_os("SPLITSUM_CACHE") {
+        return PathBuf::from(d);
+    }
+    if let Some(d) = std::env::var_os("XDG_CACHE_HOME") {
+        return PathBuf::from(d).join("splitsum");
+    }
+    if let Some(h) = std::env::var_os("HOME") {
+        return PathBuf::from(h).join(".cache").join("splitsum");
+    }
+    PathBuf::from(".splitsum-cache")
+}
+
+/// The key of a bake: BLAKE3 of the format, the environment's identity (the hash of its
+/// bytes, `environment::identity`), the plan (as JSON), the backend and the SPIR-V module.
+pub fn key(environment: &[u8], plan_json: &str, backend: &str) -> String {
+    let mut h = blake3::Hasher::new();
+    for part in [FORMAT.as_bytes(), environment, plan_json.as_bytes(), backend.as_bytes(), splitsum_spirv::bytes()] {
+        h.update(&(part.len() as u64).to_le_bytes());
+        h.update(part);
+    }
+    h.finalize().to_hex().to_string()
+}
+
+#[derive(Serialize, Deserialize)]
+struct FileEntry {
+    bytes: u64,
+    blake3: String,
+}
+
+#[derive(Serialize, Deserialize)]
+struct Manifest {
+    format: String,
+    key: String,
+    mapping: u32,
+    files: BTreeMap<String, FileEntry>,
+}
+
+/// What a lookup found.
+pub enum Lookup {
+    /// A valid entry.
+    Hit(Box<BakedEnvironment>),
+    /// No entry.
+    Miss,
+    /// An entry that may not be used, and why; it has been removed.
+    Rejected(String),
+}
+
+/// A cache folder.
+pub struct Cache {
+    dir: PathBuf,
+}
+
+fn cube_bytes(c: &Cube) -> Vec<u8> {
+    let mut out = Vec::with_capacity(16 + c.texels.len() * 16);
+    out.extend_from_slice(&c.layout.size.to_le_bytes());
+    out.extend_from_slice(&c.layout.levels.to_le_bytes());
+    out.extend_from_slice(bytemuck::cast_slice(&c.texels));
+    out
+}
+
+fn cube_from(bytes: &[u8]) -> Option<Cube> {
+    let size = u32::from_le_bytes(bytes.get(0..4)?.try_into().ok()?);
+    let levels = u32::from_le_bytes(bytes.get(4..8)?.try_into().ok()?);
+    if size == 0 || !size.is_power_of_two() || levels == 0 || levels > 16 {
+        return None;
+    }
+    let layout = CubeLayout::new(size, levels);
+    let data = bytes.get(8..)?;
+    (data.len() == layout.texel_count() as usize * 16).then(|| Cube { layout, texels: bytemuck::pod_collect_to_vec::<u8, Vec4>(data) })
+}
+
+impl Cache {
+    /// The cache in `dir` (created on first write).
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self { dir: dir.into() }
+    }
+
+    /// Where entry `key` lives.
+    pub fn entry(&self, key: &str) -> PathBuf {
+        self.dir.join(key)
+    }
+
+    /// Takes the lock of entry `key` (a `.lock` file beside it, locked exclusively by the
+    /// operating system, so a crashed holder releases it): concurrent runs that bake the
+    /// same key take turns, and each after the first finds the entry the first stored. Says
+    /// on stderr when it has to wait. Held until the returned file is dropped.
+    pub fn lock(&self, key: &str) -> Result<std::fs::File> {
+        std::fs::create_dir_all(&self.dir).map_err(|e| Error::file(&self.dir, format!("cannot create the cache folder: {e}")))?;
+        let path = self.dir.join(format!("{key}.lock"));
+        let file = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&path)
+            .map_err(|e| Error::file(&path, format!("cannot open the cache lock: {e}")))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                eprintln!("waiting for another run that bakes the same scene (cache lock {})", path.display());
+                file.lock().map_err(|e| Error::file(&path, format!("cannot lock: {e}")))?;
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(Error::file(&path, format!("cannot lock: {e}"))),
+        }
+        Ok(file)
+    }
+
+    /// Looks up `key`, checking the manifest's key and every file's hash.
+    pub fn get(&self, key: &str) -> Lookup {
+        let dir = self.entry(key);
+        if !dir.exists() {
+            return Lookup::Miss;
+        }
+        match self.read(key, &dir) {
+            Ok(env) => Lookup::Hit(Box::new(env)),
+            Err(why) => {
+                let _ = std::fs::remove_dir_all(&dir);
+                Lookup::Rejected(why)
+            }
+        }
+    }
+
+    fn read(&self, key: &str, dir: &Path) -> std::result::Result<BakedEnvironment, String> {
+        let text = std::fs::read_to_string(dir.join("manifest.json")).map_err(|e| format!("no readable manifest ({e})"))?;
+        let m: Manifest = serde_json::from_str(&text).map_err(|e| format!("malformed manifest ({e})"))?;
+        if m.format != FORMAT || m.key != key {
+            return Err(format!("a foreign entry (its manifest names key {} in format {})", m.key, m.format));
+        }
+        let file = |name: &str| -> std::result::Result<Vec<u8>, String> {
+            let want = m.files.get(name).ok_or_else(|| format!("the manifest lists no {name}"))?;
+            let bytes = std::fs::read(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?;
+            if bytes.len() as u64 != want.bytes || blake3::hash(&bytes).to_hex().as_str() != want.blake3 {
+                return Err(format!("{name} is corrupt (size or BLAKE3 hash differs from the manifest)"));
+            }
+            Ok(bytes)
+        };
+        let bad = |name: &str| format!("{name} does not hold a cube");
+        let source = cube_from(&file("source.bin")?).ok_or_else(|| bad("source.bin"))?;
+        let specular = cube_from(&file("specular.bin")?).ok_or_else(|| bad("specular.bin"))?;
+        let irradiance = cube_from(&file("irradiance.bin")?).ok_or_else(|| bad("irradiance.bin"))?;
+        let lut_bytes = file("lut.bin")?;
+        let size = u32::from_le_bytes(lut_bytes.get(0..4).ok_or("lut.bin is empty")?.try_into().map_err(|_| "lut.bin")?);
+        let data = &lut_bytes[4..];
+        if size == 0 || data.len() != (size * size) as usize * 8 {
+            return Err("lut.bin does not hold a table".into());
+        }
+        let lut = Lut { size, texels: bytemuck::pod_collect_to_vec::<u8, Vec2>(data) };
+        Ok(BakedEnvironment { source, specular, irradiance, lut, mapping: RoughnessMapping::from_u32(m.mapping) })
+    }
+
+    /// Stores `env` under `key` (atomically: a temporary folder renamed into place).
+    pub fn put(&self, key: &str, env: &BakedEnvironment) -> Result<()> {
+        let tmp = self.dir.join(format!(".{key}.{}.tmp", std::process::id()));
+        let fail = |e: std::io::Error| Error::file(&self.dir, format!("cannot write the cache: {e}"));
+        std::fs::create_dir_all(&tmp).map_err(fail)?;
+        let mut files = BTreeMap::new();
+        let mut lut = env.lut.size.to_le_bytes().to_vec();
+        lut.extend_from_slice(bytemuck::cast_slice(&env.lut.texels));
+        let source = Cube { layout: CubeLayout::new(env.source.layout.size, 1), texels: env.source.level(0).to_vec() };
+        for (name, bytes) in [
+            ("source.bin", cube_bytes(&source)),
+            ("specular.bin", cube_bytes(&env.specular)),
+            ("irradiance.bin", cube_bytes(&env.irradiance)),
+            ("lut.bin", lut),
+        ] {
+            std::fs::write(tmp.join(name), &bytes).map_err(fail)?;
+            files.insert(name.to_string(), FileEntry { bytes: bytes.len() as u64, blake3: blake3::hash(&bytes).to_hex().to_string() });
+        }
+        let manifest = Manifest { format: FORMAT.into(), key: key.into(), mapping: env.mapping as u32, files };
+        std::fs::write(tmp.join("manifest.json"), serde_json::to_string_pretty(&manifest).expect("serialisable")).map_err(fail)?;
+        let dest = self.entry(key);
+        let _ = std::fs::remove_dir_all(&dest);
+        std::fs::rename(&tmp, &dest).map_err(fail)
+    }
+}

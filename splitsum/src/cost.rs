@@ -1,0 +1,219 @@
+//! What a bake costs before it runs: the error model and cost rates a plan chooses from
+//! ([`Calibration`]), and the time and memory of given settings ([`estimate`],
+//! [`step_seconds`]).
+
+use crate::settings::{Products, Settings, TableMethod};
+use serde::Serialize;
+use splitsum_shaders::cubemap::CubeLayout;
+
+/// Error of each product against its reference, per setting, and the cost rates of each
+/// backend: what the planner chooses from. The built-in one is `runner report` on the two
+/// vendored HDRIs with a 34 000 sun and without (the worse of the two), on lavapipe and
+/// on 2 CPU cores, November 2026.
+#[derive(Clone, Debug, Serialize)]
+pub struct Calibration {
+    /// Where the numbers come from.
+    pub source: String,
+    /// BRDF table: (samples, mean absolute error).
+    pub lut: Vec<(u32, f64)>,
+    /// The specular bake, end to end: (roughness at the middle of a band, [(samples at mip
+    /// 1, mean relative error the bake adds to the shaded colour)]), from the report's
+    /// `shaded colour r in [a, b): (a) bake` rows of the defaults at several sample counts.
+    pub prefilter: Vec<(f32, Vec<(u32, f64)>)>,
+    /// Irradiance convolution: (source face size, mean relative error).
+    pub irradiance: Vec<(u32, f64)>,
+    /// Nanoseconds per unit of work on (lavapipe, CPU): equirect supersample, prefilter
+    /// sample, BRDF table sample, irradiance texel pair.
+    pub ns: [(f64, f64); 4],
+}
+
+impl Default for Calibration {
+    fn default() -> Self {
+        Self {
+            source: "built in: runner report on city.exr and courtyard.exr (the worse of the two), runner bench, lavapipe and 2 CPU cores".into(),
+            lut: vec![(16, 1.98e-2), (64, 6.62e-3), (256, 2.56e-3), (1024, 8.86e-4), (4096, 2.93e-4)],
+            // Bands [0.02, 0.05) … [0.75, 1] of `runner report` on city.exr and courtyard.exr
+            // (the worse of the two), CPU backend.
+            prefilter: vec![
+                (0.035, vec![(16, 0.0618), (64, 0.0592), (256, 0.0586)]),
+                (0.075, vec![(16, 0.357), (64, 0.359), (256, 0.357)]),
+                (0.15, vec![(16, 0.0987), (64, 0.122), (256, 0.104)]),
+                (0.275, vec![(16, 0.0998), (64, 0.0699), (256, 0.0596)]),
+                (0.425, vec![(16, 0.0696), (64, 0.0527), (256, 0.0484)]),
+                (0.625, vec![(16, 0.0411), (64, 0.0247), (256, 0.0245)]),
+                (0.875, vec![(16, 0.0383), (64, 0.0353), (256, 0.0269)]),
+            ],
+            irradiance: vec![(4, 0.035), (8, 0.0181), (16, 0.0067), (32, 0.00168), (64, 0.00083)],
+            // Rates from `runner bench` of the defaults on city.exr: 12.2 M prefilter samples in
+            // 0.51 s / 0.82 s, 36 M table evaluations (quadrature) in 0.12 s / 0.33 s, 9.4 M
+            // irradiance texel pairs in 0.077 s / 0.156 s.
+            ns: [(139.0, 46.0), (41.5, 67.0), (3.3, 9.1), (8.2, 16.5)],
+        }
+    }
+}
+
+/// A `report.csv` row of the end-to-end measure's bake share for the defaults at some
+/// sample count: product `shaded colour r in [a, b): (a) bake`, setting `defaults` or
+/// `defaults, N samples`; gives the band's middle and `N`.
+fn bake_share(product: &str, setting: &str) -> Option<(f32, u32)> {
+    let band = product.strip_prefix("shaded colour r in [")?.strip_suffix(": (a) bake")?;
+    let (a, rest) = band.split_once(", ")?;
+    let b = rest.trim_end_matches([')', ']']);
+    let (a, b): (f32, f32) = (a.parse().ok()?, b.parse().ok()?);
+    let n = if setting == "defaults" { Settings::default().samples } else { setting.strip_prefix("defaults, ")?.strip_suffix(" samples")?.parse().ok()? };
+    Some((0.5 * (a + b), n))
+}
+
+impl Calibration {
+    /// Reads the error model from a `report.csv` of `runner report` (its first backend),
+    /// keeping the built-in cost rates; `None` if it has no rows of a product.
+    pub fn from_report_csv(text: &str) -> Option<Self> {
+        let mut c = Calibration { source: "report.csv".into(), lut: vec![], prefilter: vec![], irradiance: vec![], ..Default::default() };
+        let mut backend: Option<String> = None;
+        let mut reader = csv::ReaderBuilder::new().flexible(true).from_reader(text.as_bytes());
+        for record in reader.records() {
+            let f = record.ok()?;
+            if f.len() < 7 {
+                continue;
+            }
+            if backend.is_none() && &f[3] != "NaN" {
+                backend = Some(f[1].to_string());
+            }
+            if Some(&f[1]) != backend.as_deref() {
+                continue;
+            }
+            let err: f64 = f[4].parse().ok()?;
+            let first_number = |s: &str| s.split(|ch: char| !ch.is_ascii_digit()).find(|t| !t.is_empty()).and_then(|t| t.parse::<u32>().ok());
+            if &f[0] == "brdf lut" {
+                // The sampled table's rows (the quadrature's row has no sample count).
+                if let Some(n) = first_number(&f[2]) {
+                    c.lut.push((n, err));
+                }
+            } else if &f[0] == "irradiance (convolution)" {
+                c.irradiance.push((first_number(&f[2])?, err));
+            } else if let Some((r, n)) = bake_share(&f[0], &f[2]) {
+                match c.prefilter.iter_mut().find(|(x, _)| (*x - r).abs() < 1e-3) {
+                    Some((_, v)) => {
+                        v.push((n, err));
+                        v.sort_by_key(|&(n, _)| n);
+                    }
+                    None => c.prefilter.push((r, vec![(n, err)])),
+                }
+            }
+        }
+        (!c.lut.is_empty() && !c.prefilter.is_empty() && !c.irradiance.is_empty()).then_some(c)
+    }
+
+    /// The bake's share of the shaded colour's error at `roughness` (the nearest band) with
+    /// `samples` at mip 1.
+    pub fn prefilter_error(&self, roughness: f32, samples: u32) -> f64 {
+        // The measured roughness nearest to the one asked for.
+        let table = &self.prefilter.iter().min_by(|a, b| (a.0 - roughness).abs().total_cmp(&(b.0 - roughness).abs())).expect("calibrated").1;
+        interpolate(table, samples)
+    }
+}
+
+/// Log–log interpolation of `(setting, error)` pairs at `x` (clamped to the table).
+pub fn interpolate(table: &[(u32, f64)], x: u32) -> f64 {
+    let x = x as f64;
+    if x <= table[0].0 as f64 {
+        return table[0].1;
+    }
+    for w in table.windows(2) {
+        let (x0, y0, x1, y1) = (w[0].0 as f64, w[0].1, w[1].0 as f64, w[1].1);
+        if x <= x1 {
+            let t = (x.ln() - x0.ln()) / (x1.ln() - x0.ln());
+            return (y0.ln() + t * (y1.ln() - y0.ln())).exp();
+        }
+    }
+    table[table.len() - 1].1
+}
+
+/// Estimated cost.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Cost {
+    /// Seconds on lavapipe.
+    pub gpu_seconds: f64,
+    /// Seconds on 2 CPU cores.
+    pub cpu_seconds: f64,
+    /// Bytes of the data in memory (the environment as read, the products and their sums).
+    pub bytes: u64,
+}
+
+impl Cost {
+    /// Estimated peak resident memory of the process, in bytes: the data, plus the program
+    /// itself (8 MiB) on the CPU; on lavapipe the data twice (host copies and device
+    /// buffers, both in host memory) plus the driver (118 MiB). Measured with
+    /// `/usr/bin/time` on `runner lut --size 16` (the baselines) and `runner bake` of
+    /// courtyard.exr at its defaults: 57 MiB on the CPU, 227 MiB on lavapipe, against
+    /// 8 + 55 and 118 + 2·55 estimated.
+    pub fn peak_bytes(&self, gpu: bool) -> u64 {
+        const MIB: u64 = 1 << 20;
+        if gpu { 118 * MIB + 2 * self.bytes } else { 8 * MIB + self.bytes }
+    }
+}
+
+/// The steps of a bake the cost model knows, in the order they run, with the index of
+/// their rate in [`Calibration::ns`].
+pub const STEPS: [&str; 4] = ["source cube", "specular", "brdf lut", "irradiance"];
+
+/// Units of work of each of [`STEPS`] (equirect supersamples, prefilter samples, BRDF
+/// table evaluations, irradiance texel pairs) and the bytes of the products in memory.
+fn work(s: &Settings, products: Products, levels: &[u32], width: u32) -> ([f64; 4], u64) {
+    let mut work = [0.0f64; 4];
+    let mut bytes = 0u64;
+    let n = splitsum_shaders::equirect::supersampling(s.source_size, width.max(1), s.supersample_density) as f64;
+    let source = CubeLayout::new(s.source_size, CubeLayout::full_chain(s.source_size));
+    work[0] = 6.0 * (s.source_size as f64).powi(2) * n * n;
+    bytes += source.texel_count() as u64 * 16;
+    if products.specular {
+        let out = s.specular_layout();
+        let samples = s.samples_per_mip();
+        for &l in levels {
+            let texels = 6.0 * (out.level_size(l) as f64).powi(2);
+            let r = s.mapping.roughness(l, s.mips);
+            if r > 0.0 {
+                let n = samples[l as usize];
+                // An exact sum's 6t² terms cost about an eighth of a sample each.
+                let per_texel = if s.exact_sums && splitsum_shaders::prefilter::prefers_exact(r, n, s.source_size) {
+                    6.0 * (splitsum_shaders::prefilter::exact_source_size(r, s.source_size) as f64).powi(2) / 8.0
+                } else {
+                    n as f64
+                };
+                work[1] += texels * per_texel;
+            }
+            // The sums (3 × RGBA per texel) and the result.
+            bytes += texels as u64 * 64;
+        }
+    }
+    if products.lut {
+        let per_texel = match s.lut_method {
+            TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
+            TableMethod::Sampled => s.lut_samples,
+        };
+        work[2] = (s.lut_size as f64).powi(2) * per_texel as f64;
+        bytes += (s.lut_size as u64).pow(2) * 24;
+    }
+    if products.irradiance {
+        work[3] = 6.0 * (s.irradiance_size as f64).powi(2) * 6.0 * (s.irradiance_source as f64).powi(2);
+        bytes += 6 * (s.irradiance_size as u64).pow(2) * 64;
+    }
+    (work, bytes)
+}
+
+/// Estimated seconds of each of [`STEPS`] that `products` run, on lavapipe (`gpu`) or on
+/// 2 CPU cores.
+pub fn step_seconds(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration, gpu: bool) -> [f64; 4] {
+    let (work, _) = work(s, products, levels, width);
+    std::array::from_fn(|k| work[k] * if gpu { cal.ns[k].0 } else { cal.ns[k].1 } * 1e-9)
+}
+
+/// Estimated time and memory of baking `products` (and `levels` of the specular cube)
+/// from an equirect `width` wide: the products and their sums, plus the environment as
+/// read (RGBA f32, with its row pyramid: `12·width²` bytes).
+pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration) -> Cost {
+    let (_, bytes) = work(s, products, levels, width);
+    let gpu = step_seconds(s, products, levels, width, cal, true).iter().sum();
+    let cpu = step_seconds(s, products, levels, width, cal, false).iter().sum();
+    Cost { gpu_seconds: gpu, cpu_seconds: cpu, bytes: bytes + 12 * (width as u64).pow(2) }
+}

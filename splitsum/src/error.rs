@@ -1,0 +1,80 @@
+//! Errors of the splitsum library, in its own terms: a setting by its field name, a file by
+//! its path. The command line maps them to the flags a user wrote (`runner`'s `cli`).
+
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Something splitsum could not do.
+#[derive(Debug, Error)]
+pub enum Error {
+    /// No Vulkan adapter: the GPU backend cannot run here.
+    #[error(
+        "no Vulkan GPU adapter found{detail}.\n  \
+         Bake on the CPU instead, or install a Vulkan driver; on Debian or Ubuntu the CPU \
+         driver lavapipe works: `sudo apt-get install -y mesa-vulkan-drivers libvulkan1`"
+    )]
+    NoAdapter {
+        /// What wgpu said, if anything.
+        detail: String,
+    },
+    /// The GPU device refused something (a pipeline, a buffer, a limit).
+    #[error("GPU: {0}")]
+    Gpu(String),
+    /// A file that could not be read, written or understood.
+    #[error("{}: {problem}", path.display())]
+    File {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// An environment with NaN or infinite texels, read without sanitising.
+    #[error(
+        "{}: has {nan} texels with NaN and {infinite} with an infinite value; sanitising replaces NaN and -inf by 0 and +inf by the channel's largest finite value",
+        path.display()
+    )]
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// Texels with a NaN channel.
+        nan: u64,
+        /// Texels with an infinite channel.
+        infinite: u64,
+    },
+    /// A field of `Settings` out of its range.
+    #[error("{field} {problem}")]
+    Setting {
+        /// The field of `Settings`.
+        field: &'static str,
+        /// What is wrong with its value.
+        problem: String,
+    },
+    /// A bake estimated to run longer than `bake::MAX_UNFORCED_SECONDS`, not forced.
+    #[error("this bake is estimated to take {} ({} of it for the {step})", crate::progress::seconds(*seconds), crate::progress::seconds(*step_seconds))]
+    TooLong {
+        /// The estimate, in seconds.
+        seconds: f64,
+        /// Its longest step (one of `cost::STEPS`).
+        step: &'static str,
+        /// That step's estimate.
+        step_seconds: f64,
+    },
+    /// An argument out of its range.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl Error {
+    /// A problem with the file at `path`.
+    pub fn file(path: &Path, problem: impl Into<String>) -> Self {
+        Self::File { path: path.to_path_buf(), problem: problem.into() }
+    }
+
+    /// A problem with field `field` of `Settings`.
+    pub fn setting(field: &'static str, problem: impl Into<String>) -> Self {
+        Self::Setting { field, problem: problem.into() }
+    }
+}
+
+/// splitsum's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

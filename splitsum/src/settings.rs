@@ -1,0 +1,257 @@
+//! What a bake makes and how: [`Settings`] (every knob, with the one set of defaults and
+//! the one validation) and [`Products`] (which products).
+
+use crate::error::{Error, Result};
+use crate::ktx2::Format;
+use serde::{Deserialize, Serialize};
+use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::choice::Choice;
+use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::prefilter::{self, RoughnessMapping};
+
+/// How the BRDF table is integrated.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum TableMethod {
+    /// Deterministic Gauss–Legendre quadrature (`lut::integrate_brdf_quadrature`): within
+    /// 10⁻⁵ of the f64 reference at every texel, about 550 evaluations per texel.
+    Quadrature,
+    /// Monte Carlo over `lut_samples` Hammersley points (Karis 2013; the seed method).
+    Sampled,
+}
+
+impl Choice for TableMethod {
+    const ALL: &'static [Self] = &[Self::Quadrature, Self::Sampled];
+    fn name(self) -> &'static str {
+        match self {
+            Self::Quadrature => "quadrature",
+            Self::Sampled => "sampled",
+        }
+    }
+}
+
+impl TableMethod {
+    /// The masking term a table of this method has unless one is asked for: the exact
+    /// Smith term by quadrature, Smith–Schlick by sampling (the only one it has).
+    pub fn default_masking(self) -> Masking {
+        match self {
+            TableMethod::Quadrature => Masking::SmithCorrelated,
+            TableMethod::Sampled => Masking::SmithSchlick,
+        }
+    }
+}
+
+/// Serde for a [`Choice`]: by its name.
+pub mod named {
+    use serde::{Deserialize, Deserializer, Serializer, de::Error as _};
+    use splitsum_shaders::choice::Choice;
+
+    /// Writes the choice's name.
+    pub fn serialize<S: Serializer, T: Choice>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(v.name())
+    }
+
+    /// Reads a choice by name, listing the names on a mismatch.
+    pub fn deserialize<'de, D: Deserializer<'de>, T: Choice>(d: D) -> Result<T, D::Error> {
+        let name = String::deserialize(d)?;
+        T::from_name(&name).ok_or_else(|| {
+            let names: Vec<&str> = T::ALL.iter().map(|c| c.name()).collect();
+            D::Error::custom(format!("unknown value {name:?}, expected one of {}", names.join(", ")))
+        })
+    }
+}
+
+/// Every knob of a bake. [`Settings::default`] is the one set of defaults (the CLI, the
+/// scene files and the library all start from it); [`Settings::validate`] the one check.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Settings {
+    /// Face size of mip 0 of the specular cube (a power of two).
+    pub size: u32,
+    /// Face size of the source cube the products are filtered from (a power of two, at
+    /// least `size`).
+    pub source_size: u32,
+    /// Mips of the specular cube, one roughness each.
+    pub mips: u32,
+    /// Roughness of each mip.
+    #[serde(with = "named")]
+    pub mapping: RoughnessMapping,
+    /// GGX samples per texel of specular mip 1 (the sharpest filtered mip).
+    pub samples: u32,
+    /// Factor by which the sample count grows per mip after mip 1 (1: the same count on
+    /// every mip, the seed method). Mips shrink by 4 in texels, so a factor up to 4 keeps
+    /// each mip's cost at most mip 1's, and rough lobes need the samples.
+    pub sample_growth: u32,
+    /// Sum a rough mip exactly over a coarse source level where that costs less than its
+    /// samples (`prefilter::exact_level`); false: sample every mip (the seed method).
+    pub exact_sums: bool,
+    /// Added to the source level each prefilter sample reads (`½·log₂(Ωs/Ωp) + bias`).
+    pub lod_bias: f32,
+    /// Supersampling density of the equirect → cube resampling (points per source texel
+    /// width at the equator).
+    pub supersample_density: f32,
+    /// Face size of the irradiance cube.
+    pub irradiance_size: u32,
+    /// Face size of the source level the irradiance convolution sums over.
+    pub irradiance_source: u32,
+    /// Face size of the source level projected onto SH9.
+    pub sh_source: u32,
+    /// Width and height of the BRDF table.
+    pub lut_size: u32,
+    /// Samples per texel of the BRDF table (with `lut_method = sampled`).
+    pub lut_samples: u32,
+    /// How the BRDF table is integrated.
+    #[serde(with = "named")]
+    pub lut_method: TableMethod,
+    /// The table's masking–shadowing term.
+    #[serde(with = "named")]
+    pub lut_masking: Masking,
+    /// Texel format of the KTX2 files.
+    #[serde(with = "named")]
+    pub format: Format,
+}
+
+impl Default for Settings {
+    fn default() -> Self {
+        Self {
+            size: 256,
+            source_size: 256,
+            mips: 6,
+            mapping: RoughnessMapping::Geometric,
+            samples: 64,
+            sample_growth: 2,
+            exact_sums: true,
+            lod_bias: 0.5,
+            supersample_density: 2.0,
+            irradiance_size: 32,
+            irradiance_source: 16,
+            sh_source: 32,
+            lut_size: 256,
+            lut_samples: 1024,
+            lut_method: TableMethod::Quadrature,
+            lut_masking: Masking::SmithCorrelated,
+            format: Format::Auto,
+        }
+    }
+}
+
+/// Largest cube face accepted.
+pub const MAX_SIZE: u32 = 4096;
+
+impl Settings {
+    /// Checks every value; an error names the field (`Error::Setting`).
+    pub fn validate(&self) -> Result<()> {
+        let pow2 = |field: &'static str, v: u32, lo: u32, hi: u32| -> Result<()> {
+            if !v.is_power_of_two() || v < lo || v > hi {
+                return Err(Error::setting(field, format!("must be a power of two from {lo} to {hi}, not {v}")));
+            }
+            Ok(())
+        };
+        pow2("size", self.size, 1, MAX_SIZE)?;
+        pow2("source_size", self.source_size, self.size, MAX_SIZE)?;
+        pow2("irradiance_size", self.irradiance_size, 1, 256)?;
+        pow2("irradiance_source", self.irradiance_source, 1, self.source_size.min(256))?;
+        pow2("sh_source", self.sh_source, 1, self.source_size)?;
+        let max_mips = CubeLayout::full_chain(self.size);
+        if self.mips == 0 || self.mips > max_mips {
+            return Err(Error::setting("mips", format!("must be from 1 to {max_mips} for {0}² faces, not {1}", self.size, self.mips)));
+        }
+        if self.samples == 0 {
+            return Err(Error::setting("samples", "must be at least 1, not 0"));
+        }
+        if !(1..=4).contains(&self.sample_growth) {
+            return Err(Error::setting("sample_growth", format!("must be from 1 to 4, not {}", self.sample_growth)));
+        }
+        if !(self.lod_bias.is_finite() && (-16.0..=16.0).contains(&self.lod_bias)) {
+            return Err(Error::setting("lod_bias", format!("must be within ±16, not {}", self.lod_bias)));
+        }
+        if !(self.supersample_density > 0.0 && self.supersample_density <= 16.0) {
+            return Err(Error::setting("supersample_density", format!("must be in (0, 16], not {}", self.supersample_density)));
+        }
+        if self.lut_size == 0 || self.lut_size > crate::backend::MAX_LUT_SIZE {
+            return Err(Error::setting("lut_size", format!("must be from 1 to {}, not {}", crate::backend::MAX_LUT_SIZE, self.lut_size)));
+        }
+        if self.lut_samples == 0 {
+            return Err(Error::setting("lut_samples", "must be at least 1, not 0"));
+        }
+        if self.lut_method == TableMethod::Sampled && self.lut_masking != Masking::SmithSchlick {
+            return Err(Error::setting("lut_masking", "correlated needs the quadrature table method (the sampled table is Smith–Schlick only)"));
+        }
+        Ok(())
+    }
+
+    /// The specular mip count for mip-0 faces of `size`: down to 8² faces, and at least two
+    /// (the mirror and roughness 1) where the chain has them. With the geometric mapping
+    /// this puts mip 1's GGX width at `α₁ = 2^(−M) = 4/size`: two of mip 1's texels. The one
+    /// rule for the bake, the display and the planner.
+    pub fn default_mips(size: u32) -> u32 {
+        let chain = CubeLayout::full_chain(size.max(1));
+        chain.saturating_sub(3).max(2).min(chain)
+    }
+
+    /// These settings with the mip count held within the specular cube's chain (for small
+    /// `size`s, as the report's quick sweep uses).
+    pub fn fitted(self) -> Self {
+        let mips = self.mips.min(CubeLayout::full_chain(self.size)).max(1);
+        Self { mips, irradiance_source: self.irradiance_source.min(self.source_size), sh_source: self.sh_source.min(self.source_size), ..self }
+    }
+
+    /// Roughness of each specular mip.
+    pub fn roughness(&self) -> Vec<f32> {
+        (0..self.mips).map(|i| self.mapping.roughness(i, self.mips)).collect()
+    }
+
+    /// The BRDF table these settings bake, in words: `256² by quadrature (correlated)` or
+    /// `256² × 1024 samples`.
+    pub fn table_description(&self) -> String {
+        match self.lut_method {
+            TableMethod::Quadrature => format!("{}² by quadrature ({})", self.lut_size, self.lut_masking.name()),
+            TableMethod::Sampled => format!("{}² × {} samples", self.lut_size, self.lut_samples),
+        }
+    }
+
+    /// GGX samples of each specular mip: `samples × sample_growth^(m−1)` from mip 1 on
+    /// (mip 0 is the mirror unless the mapping says otherwise), at most 2²⁰.
+    pub fn samples_per_mip(&self) -> Vec<u32> {
+        (0..self.mips).map(|m| (self.samples as u64 * (self.sample_growth as u64).pow(m.saturating_sub(1))).min(1 << 20) as u32).collect()
+    }
+
+    /// Every mip of the specular cube: `0 .. mips`.
+    pub fn all_levels(&self) -> Vec<u32> {
+        (0..self.mips).collect()
+    }
+
+    /// Layout of the specular cube.
+    pub fn specular_layout(&self) -> CubeLayout {
+        CubeLayout::new(self.size, self.mips)
+    }
+}
+
+/// The source level each specular level is summed over exactly, or `prefilter::SAMPLED`:
+/// with `exact`, wherever that costs less than its samples (`prefilter::exact_level`).
+pub fn exact_levels(roughness: &[f32], samples: &[u32], exact: bool, src: CubeLayout) -> Vec<u32> {
+    roughness.iter().zip(samples).map(|(&r, &n)| if exact { prefilter::exact_level(r, n, src) } else { prefilter::SAMPLED }).collect()
+}
+
+/// The source level whose faces are `face` wide (or the smallest there is).
+pub fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
+    (0..layout.levels).find(|&l| layout.level_size(l) <= face).unwrap_or(layout.levels - 1)
+}
+
+/// Which products to bake.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct Products {
+    /// The prefiltered specular cube.
+    pub specular: bool,
+    /// The irradiance cube.
+    pub irradiance: bool,
+    /// The SH9 coefficients.
+    pub sh9: bool,
+    /// The BRDF table.
+    pub lut: bool,
+}
+
+impl Products {
+    /// Everything.
+    pub const ALL: Products = Products { specular: true, irradiance: true, sh9: true, lut: true };
+    /// What a renderer reads: the specular cube, the irradiance cube and the BRDF table.
+    pub const DISPLAY: Products = Products { specular: true, irradiance: true, sh9: false, lut: true };
+}

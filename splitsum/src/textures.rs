@@ -1,0 +1,432 @@
+//! Baking into textures a wgpu renderer binds directly, on the caller's device.
+//!
+//! [`Baker`] holds the caller's `wgpu::Device` and `Queue` and bakes with the kernels on
+//! that device ([`Compute::Gpu`]: the products never leave it) or natively on the CPU
+//! ([`Compute::Cpu`]: the products are uploaded). Either way the result is an [`Ibl`]: the
+//! prefiltered specular cube with one roughness per mip, the irradiance cube (`E/π`) and
+//! the split-sum BRDF table, as half-float textures. Halves are packed by
+//! `splitsum_shaders::half::pack_radiance` on both backends (the GPU in a kernel, the CPU
+//! natively), so the two agree bit for bit where their f32 products do; values beyond
+//! 65504 (a sun) are clamped to 65504, never ∞.
+//!
+//! The source is CPU data ([`Source::Environment`]) or a texture of the caller's
+//! ([`Source::Texture`]: an equirect `2h × h`, or a cube of six square layers; RGBA16F or
+//! RGBA32F with `COPY_SRC`). Nothing is read back unless asked ([`Ibl::read`]).
+
+use crate::backend::{Cpu, Gpu, Kernels, gpu::Texels};
+use crate::bake::{self, Baked, Made, Timing};
+use crate::environment::Environment;
+use crate::error::{Error, Result};
+use crate::settings::{Products, Settings};
+use crate::texture::{Cube, Equirect};
+use splitsum_shaders::cubemap::{CubeLayout, FACES};
+use splitsum_shaders::glam::Vec4;
+use splitsum_shaders::half::{clean_radiance, f16_bits_to_f32, pack_radiance};
+use splitsum_shaders::kernels::RowsParams;
+use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_spirv as spirv;
+
+/// Where the bake runs.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Compute {
+    /// The kernels, on the caller's device.
+    Gpu,
+    /// The same functions natively on the CPU (rayon), the results uploaded.
+    Cpu,
+}
+
+/// What to bake from.
+#[derive(Copy, Clone)]
+pub enum Source<'a> {
+    /// An equirect image or six cube faces in host memory (`crate::environment` reads
+    /// them from files).
+    Environment(&'a Environment),
+    /// A texture on the caller's device: an equirect (`2h × h`, one layer) or a cube (six
+    /// square layers; mip 0 is read), RGBA16F or RGBA32F, with `COPY_SRC` usage. NaN and
+    /// negative texels are read as 0.
+    Texture(&'a wgpu::Texture),
+}
+
+/// The baked products as textures on the caller's device.
+pub struct Ibl {
+    /// Prefiltered specular radiance: a cube (six layers) of `Rgba16Float`, mip `m` at
+    /// roughness `roughness[m]` (GGX, `α = roughness²`).
+    pub specular: wgpu::Texture,
+    /// Irradiance divided by π: a cube of `Rgba16Float`; a Lambert surface of albedo `ρ`
+    /// reflects `ρ` times the value.
+    pub irradiance: wgpu::Texture,
+    /// The split-sum BRDF table, `Rg16Float`: `(A, B)` with x = n·v, y = roughness; the
+    /// specular reflectance is `F₀·A + B` (Karis 2013).
+    pub brdf: wgpu::Texture,
+    /// Roughness of each specular mip.
+    pub roughness: Vec<f32>,
+    /// How roughness is spread over the mips (`roughness[m] = mapping.roughness(m, mips)`).
+    pub mapping: RoughnessMapping,
+    /// Wall time of each step.
+    pub timings: Vec<Timing>,
+}
+
+/// The products read back from an [`Ibl`]'s textures, as f32.
+pub struct IblData {
+    /// The specular cube.
+    pub specular: Cube,
+    /// The irradiance cube.
+    pub irradiance: Cube,
+    /// The BRDF table, `(A, B, 0, 0)` per texel.
+    pub brdf: Vec<Vec4>,
+}
+
+/// Bakes on the caller's device.
+pub struct Baker {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    gpu: Option<Gpu>,
+}
+
+/// Bytes per row of a texture copy: `bytes` rounded up to wgpu's 256-byte alignment.
+fn pitch(bytes: u32) -> u32 {
+    bytes.next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+}
+
+impl Baker {
+    /// A baker on `device` and `queue` (wgpu handles are shared: splitsum's work runs on
+    /// the caller's queue). With [`Compute::Gpu`] this builds the kernels' pipelines (once;
+    /// keep the baker to bake again without that cost).
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, compute: Compute) -> Result<Self> {
+        let gpu = match compute {
+            Compute::Gpu => Some(Gpu::on_device(device, queue)?),
+            Compute::Cpu => None,
+        };
+        Ok(Self { device: device.clone(), queue: queue.clone(), gpu })
+    }
+
+    /// Where this baker bakes.
+    pub fn compute(&self) -> Compute {
+        if self.gpu.is_some() { Compute::Gpu } else { Compute::Cpu }
+    }
+
+    /// Bakes the specular cube, the irradiance cube and the BRDF table of `source` with
+    /// `settings` (validated first) into textures on the baker's device.
+    pub fn bake(&self, source: Source<'_>, settings: &Settings) -> Result<Ibl> {
+        settings.validate()?;
+        let levels = settings.all_levels();
+        let products = Products::DISPLAY;
+        match &self.gpu {
+            Some(g) => {
+                let made = match source {
+                    Source::Environment(env) => bake::make(g, true, env, settings, products, &levels)?,
+                    Source::Texture(t) => {
+                        let est = [0.0; 4];
+                        let mut timings = Vec::new();
+                        let start = std::time::Instant::now();
+                        let (src, layout) = texture_source_cube(g, t, settings)?;
+                        timings.push(Timing { product: "source cube", seconds: start.elapsed().as_secs_f64() });
+                        bake::products(g, src, layout, settings, products, &levels, &est, timings)?
+                    }
+                };
+                self.gpu_textures(g, made, settings)
+            }
+            None => {
+                let owned;
+                let env = match source {
+                    Source::Environment(env) => env,
+                    Source::Texture(t) => {
+                        owned = self.read_source(t)?;
+                        &owned
+                    }
+                };
+                let made = bake::make(&Cpu, false, env, settings, products, &levels)?;
+                let baked = bake::read(&Cpu, made, settings)?;
+                Ok(self.upload(&baked, settings))
+            }
+        }
+    }
+
+    /// The textures of `settings`' products, empty.
+    fn textures(&self, settings: &Settings) -> (wgpu::Texture, wgpu::Texture, wgpu::Texture) {
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
+        let cube = |label, size, mips| {
+            self.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: FACES },
+                mip_level_count: mips,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let lut = settings.lut_size;
+        let brdf = self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("splitsum brdf table"),
+            size: wgpu::Extent3d { width: lut, height: lut, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rg16Float,
+            usage,
+            view_formats: &[],
+        });
+        (cube("splitsum specular", settings.size, settings.mips), cube("splitsum irradiance", settings.irradiance_size, 1), brdf)
+    }
+
+    fn ibl(&self, settings: &Settings, textures: (wgpu::Texture, wgpu::Texture, wgpu::Texture), timings: Vec<Timing>) -> Ibl {
+        let (specular, irradiance, brdf) = textures;
+        Ibl { specular, irradiance, brdf, roughness: settings.roughness(), mapping: settings.mapping, timings }
+    }
+
+    /// Packs the products on the device and copies them into the textures.
+    fn gpu_textures(&self, g: &Gpu, made: Made<Texels>, settings: &Settings) -> Result<Ibl> {
+        let textures = self.textures(settings);
+        let missing = || Error::Invalid("a display bake made no product".into());
+        let spec = made.specular.as_ref().ok_or_else(missing)?;
+        let irr = made.irradiance.as_ref().ok_or_else(missing)?;
+        let lut = made.lut.as_ref().ok_or_else(missing)?;
+        self.gpu_copy(g, spec, settings.specular_layout(), FACES, 4, &textures.0)?;
+        self.gpu_copy(g, irr, CubeLayout::new(settings.irradiance_size, 1), FACES, 4, &textures.1)?;
+        self.gpu_copy(g, lut, CubeLayout::new(settings.lut_size, 1), 1, 2, &textures.2)?;
+        Ok(self.ibl(settings, textures, made.timings))
+    }
+
+    /// Packs every level of `texels` (laid out as `layout` with `layers` layers) into
+    /// halves, `channels` per texel, and copies them into `texture`.
+    fn gpu_copy(&self, g: &Gpu, texels: &Texels, layout: CubeLayout, layers: u32, channels: u32, texture: &wgpu::Texture) -> Result<()> {
+        let mut params = Vec::new();
+        let mut words = 0u32;
+        for m in 0..layout.levels {
+            let s = layout.level_size(m);
+            let row_words = pitch(s * channels * 2) / 4;
+            let offset = if layers == 1 { 0 } else { layout.level_offset(m) };
+            params.push(RowsParams { width: s, rows: layers * s, texel_offset: offset, row_words, word_offset: words, channels, half: 1 });
+            words += row_words * layers * s;
+        }
+        let packed = g.output("packed halves", words as u64 * 4)?;
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum textures") });
+        let dispatches: Vec<crate::backend::gpu::Dispatch> = params
+            .iter()
+            .map(|p| crate::backend::gpu::Dispatch {
+                kernel: &spirv::KERNELS_PACK_HALF,
+                params: bytemuck::bytes_of(p),
+                input: Some(&texels.buffer),
+                output: &packed,
+                invocations: [p.width, p.rows, 1],
+            })
+            .collect();
+        g.record(&mut encoder, &dispatches);
+        for (m, p) in params.iter().enumerate() {
+            encoder.copy_buffer_to_texture(
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &packed,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: p.word_offset as u64 * 4,
+                        bytes_per_row: Some(p.row_words * 4),
+                        rows_per_image: Some(p.width),
+                    },
+                },
+                wgpu::TexelCopyTextureInfo { texture, mip_level: m as u32, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+                wgpu::Extent3d { width: p.width, height: p.width, depth_or_array_layers: layers },
+            );
+        }
+        self.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// Packs host products into halves (the same function the kernel runs) and writes
+    /// them into new textures.
+    fn upload(&self, baked: &Baked, settings: &Settings) -> Ibl {
+        let textures = self.textures(settings);
+        let write = |texture: &wgpu::Texture, texels: &[Vec4], layout: CubeLayout, layers: u32, channels: u32| {
+            for m in 0..layout.levels {
+                let s = layout.level_size(m);
+                let start = if layers == 1 { 0 } else { layout.level_offset(m) as usize };
+                let level = &texels[start..start + (layers * s * s) as usize];
+                let words: Vec<u32> = level
+                    .iter()
+                    .flat_map(|v| if channels == 4 { vec![pack_radiance(v.x, v.y), pack_radiance(v.z, v.w)] } else { vec![pack_radiance(v.x, v.y)] })
+                    .collect();
+                self.queue.write_texture(
+                    wgpu::TexelCopyTextureInfo { texture, mip_level: m, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+                    bytemuck::cast_slice(&words),
+                    wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(s * channels * 2), rows_per_image: Some(s) },
+                    wgpu::Extent3d { width: s, height: s, depth_or_array_layers: layers },
+                );
+            }
+        };
+        let (spec, irr, lut) = (baked.specular.as_ref().expect("baked"), baked.irradiance.as_ref().expect("baked"), baked.lut.as_ref().expect("baked"));
+        write(&textures.0, &spec.texels, spec.layout, FACES, 4);
+        write(&textures.1, &irr.texels, irr.layout, FACES, 4);
+        let table: Vec<Vec4> = lut.texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect();
+        write(&textures.2, &table, CubeLayout::new(lut.size, 1), 1, 2);
+        self.ibl(settings, textures, baked.timings.clone())
+    }
+
+    /// Copies mip 0 of `texture` (every layer) into a buffer of 256-byte-aligned rows:
+    /// the buffer, its row pitch in bytes, and whether the texels are halves.
+    fn copy_out(&self, texture: &wgpu::Texture, usage: wgpu::BufferUsages) -> Result<(wgpu::Buffer, u32, bool)> {
+        let half = match texture.format() {
+            wgpu::TextureFormat::Rgba16Float => true,
+            wgpu::TextureFormat::Rgba32Float => false,
+            f => return Err(Error::Invalid(format!("the source texture is {f:?}; splitsum reads Rgba16Float or Rgba32Float"))),
+        };
+        if !texture.usage().contains(wgpu::TextureUsages::COPY_SRC) {
+            return Err(Error::Invalid("the source texture needs TextureUsages::COPY_SRC for splitsum to read it".into()));
+        }
+        let size = texture.size();
+        let row = pitch(size.width * if half { 8 } else { 16 });
+        let buffer = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("splitsum source texture"),
+            size: row as u64 * size.height as u64 * size.depth_or_array_layers as u64,
+            usage: usage | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum source") });
+        encoder.copy_texture_to_buffer(
+            texture.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(size.height) },
+            },
+            size,
+        );
+        self.queue.submit([encoder.finish()]);
+        Ok((buffer, row, half))
+    }
+
+    /// A caller's texture read into host memory (the CPU backend's source).
+    fn read_source(&self, texture: &wgpu::Texture) -> Result<Environment> {
+        let shape = texture_shape(texture)?;
+        let (buffer, row, half) = self.copy_out(texture, wgpu::BufferUsages::MAP_READ)?;
+        let bytes = crate::backend::gpu::map_read(&self.device, &buffer)?;
+        let words: &[u32] = bytemuck::cast_slice(&bytes);
+        let size = texture.size();
+        let row_words = (row / 4) as usize;
+        let mut texels = Vec::with_capacity((size.width * size.height * size.depth_or_array_layers) as usize);
+        for r in 0..(size.height * size.depth_or_array_layers) as usize {
+            for x in 0..size.width as usize {
+                let w = &words[r * row_words..];
+                let v = if half {
+                    let (a, b) = (w[2 * x], w[2 * x + 1]);
+                    Vec4::new(f16_bits_to_f32(a & 0xffff), f16_bits_to_f32(a >> 16), f16_bits_to_f32(b & 0xffff), f16_bits_to_f32(b >> 16))
+                } else {
+                    Vec4::new(f32::from_bits(w[4 * x]), f32::from_bits(w[4 * x + 1]), f32::from_bits(w[4 * x + 2]), f32::from_bits(w[4 * x + 3]))
+                };
+                texels.push(clean_radiance(v).truncate().extend(1.0));
+            }
+        }
+        Ok(match shape {
+            Shape::Equirect => Environment::Equirect(Equirect { width: size.width, height: size.height, texels }),
+            Shape::Cube => Environment::Cube(Cube { layout: CubeLayout::new(size.width, 1), texels }),
+        })
+    }
+}
+
+/// What a source texture holds.
+enum Shape {
+    Equirect,
+    Cube,
+}
+
+fn texture_shape(t: &wgpu::Texture) -> Result<Shape> {
+    let s = t.size();
+    if s.depth_or_array_layers == FACES && s.width == s.height && s.width.is_power_of_two() {
+        Ok(Shape::Cube)
+    } else if s.depth_or_array_layers == 1 && s.width == 2 * s.height && s.height > 0 {
+        Ok(Shape::Equirect)
+    } else {
+        Err(Error::Invalid(format!(
+            "the source texture is {}×{} with {} layers; splitsum reads an equirect (2h×h, one layer) or a cube (six square layers of a power-of-two size)",
+            s.width, s.height, s.depth_or_array_layers
+        )))
+    }
+}
+
+/// The source cube of `settings` from a texture on the device, without leaving it.
+fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) -> Result<(Texels, CubeLayout)> {
+    let shape = texture_shape(texture)?;
+    let baker = Baker { device: g.device.clone(), queue: g.queue.clone(), gpu: None };
+    let (words, row, half) = baker.copy_out(texture, wgpu::BufferUsages::STORAGE)?;
+    let size = texture.size();
+    let rows = size.height * size.depth_or_array_layers;
+    let count = match shape {
+        Shape::Equirect => splitsum_shaders::equirect::pyramid_len(size.width, size.height),
+        Shape::Cube => CubeLayout::new(size.width, CubeLayout::full_chain(size.width)).texel_count(),
+    };
+    let texels = Texels { buffer: g.output("source texels", count as u64 * 16)?, count };
+    let p = RowsParams { width: size.width, rows, texel_offset: 0, row_words: row / 4, word_offset: 0, channels: 4, half: half as u32 };
+    g.run(&[crate::backend::gpu::Dispatch {
+        kernel: &spirv::KERNELS_UNPACK_ROWS,
+        params: bytemuck::bytes_of(&p),
+        input: Some(&words),
+        output: &texels.buffer,
+        invocations: [size.width, rows, 1],
+    }]);
+    let source_size = settings.source_size;
+    let layout = CubeLayout::new(source_size, CubeLayout::full_chain(source_size));
+    match shape {
+        Shape::Equirect => {
+            let n = splitsum_shaders::equirect::supersampling(source_size, size.width, settings.supersample_density);
+            Ok((g.pyramid_to_cube(&texels.buffer, size.width, size.height, source_size, n)?, layout))
+        }
+        Shape::Cube => {
+            let f = size.width;
+            if f < source_size {
+                return Err(Error::setting("source_size", format!("{source_size} is larger than the cube's {f}×{f} faces; upsampling adds nothing")));
+            }
+            let full = CubeLayout::new(f, CubeLayout::full_chain(f));
+            let mut texels = texels;
+            g.build_mips(&mut texels, full)?;
+            let first = crate::settings::level_of_size(full, source_size);
+            let start = full.level_offset(first);
+            Ok((g.slice(&texels, start, full.texel_count() - start)?, layout))
+        }
+    }
+}
+
+impl Ibl {
+    /// The specular mip (fractional, for trilinear lookups) that holds `roughness`.
+    pub fn lod(&self, roughness: f32) -> f32 {
+        self.mapping.lod(roughness, self.roughness.len() as u32)
+    }
+
+    /// Reads the textures back (decoding the halves): for tests, inspection and files.
+    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<IblData> {
+        let read = |t: &wgpu::Texture, channels: u32| -> Result<Vec<Vec4>> {
+            let mut out = Vec::new();
+            let layers = t.size().depth_or_array_layers;
+            for m in 0..t.mip_level_count() {
+                let s = (t.size().width >> m).max(1);
+                let row = pitch(s * channels * 2);
+                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("splitsum readback"),
+                    size: row as u64 * s as u64 * layers as u64,
+                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                    mapped_at_creation: false,
+                });
+                let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+                encoder.copy_texture_to_buffer(
+                    wgpu::TexelCopyTextureInfo { texture: t, mip_level: m, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+                    wgpu::TexelCopyBufferInfo {
+                        buffer: &buffer,
+                        layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(s) },
+                    },
+                    wgpu::Extent3d { width: s, height: s, depth_or_array_layers: layers },
+                );
+                queue.submit([encoder.finish()]);
+                let bytes = crate::backend::gpu::map_read(device, &buffer)?;
+                let words: &[u32] = bytemuck::cast_slice(&bytes);
+                for r in 0..(s * layers) as usize {
+                    let w = &words[r * (row / 4) as usize..];
+                    for x in 0..s as usize {
+                        let h = |k: usize| f16_bits_to_f32(if k % 2 == 0 { w[k / 2] & 0xffff } else { w[k / 2] >> 16 });
+                        let c = channels as usize * x;
+                        out.push(if channels == 4 { Vec4::new(h(c), h(c + 1), h(c + 2), h(c + 3)) } else { Vec4::new(h(c), h(c + 1), 0.0, 0.0) });
+                    }
+                }
+            }
+            Ok(out)
+        };
+        let cube = |t: &wgpu::Texture| -> Result<Cube> { Ok(Cube { layout: CubeLayout::new(t.size().width, t.mip_level_count()), texels: read(t, 4)? }) };
+        Ok(IblData { specular: cube(&self.specular)?, irradiance: cube(&self.irradiance)?, brdf: read(&self.brdf, 2)? })
+    }
+}

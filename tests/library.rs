@@ -1,0 +1,173 @@
+//! splitsum as a library, the way an application uses it: `splitsum/examples/sphere.rs`
+//! (compiled into this test and run) opens its own wgpu device, bakes with `Baker` into
+//! textures on that device, binds them and draws a sphere; these tests check what it
+//! draws against closed forms and across backends, and the texture-source route.
+
+#[path = "../splitsum/examples/sphere.rs"]
+#[allow(dead_code)]
+mod sphere;
+
+use splitsum::texture::{Cube, Equirect};
+use splitsum::{Baker, Compute, Environment, Settings, Source};
+use splitsum_reference as reference;
+use splitsum_shaders::glam::Vec4;
+use std::sync::OnceLock;
+
+/// One device for every test here (the application's, not splitsum's).
+fn device() -> &'static (wgpu::Device, wgpu::Queue) {
+    static D: OnceLock<(wgpu::Device, wgpu::Queue)> = OnceLock::new();
+    D.get_or_init(sphere::open_device)
+}
+
+fn small() -> Settings {
+    Settings { size: 16, source_size: 32, mips: Settings::default_mips(16), lut_size: 128, irradiance_size: 8, ..Settings::default() }
+}
+
+fn constant(l: f32) -> Environment {
+    Environment::Equirect(Equirect { width: 64, height: 32, texels: vec![Vec4::new(l, l, l, 1.0); 64 * 32] })
+}
+
+/// The furnace: in a constant environment `L` every prefiltered and irradiance texel is
+/// `L` (both are normalised means), so the centre of the sphere (n·v → 1) shows
+/// `ρ·L + L·(F₀·A + B)` with `(A, B)` the split-sum table at n·v = 1, here from the f64
+/// reference integral (exact Smith, as the default table). Tolerance 1 %: half floats
+/// (2⁻¹¹ relative per value), the table's last texel centre at n·v = 1 − 1/256 rather
+/// than 1 (A + B changes by under 10⁻³ there), and the pixel's n·v of 1 − 10⁻⁵.
+#[test]
+fn the_example_lights_a_sphere_in_a_furnace_as_the_closed_form_says() {
+    let (d, q) = device();
+    let (l, rho, roughness) = (0.5f32, 0.5f32, 0.5f32);
+    let (a, b) = reference::brdf_lut_with(1.0, roughness as f64, 1e-9, reference::Smith::Correlated);
+    let want = (rho * l) as f64 + l as f64 * (a + b);
+    for compute in [Compute::Gpu, Compute::Cpu] {
+        let material = sphere::Material { albedo: [rho; 3], f0: [1.0; 3], roughness };
+        let pic = sphere::draw(d, q, &constant(l), &small(), compute, material, 64).unwrap();
+        let centre = pic.pixels[(32 * 64 + 32) as usize];
+        for c in 0..3 {
+            let rel = (centre[c] as f64 - want).abs() / want;
+            assert!(rel < 1e-2, "{compute:?}: centre channel {c} = {}, the closed form {want:.5} ({rel:.2e})", centre[c]);
+        }
+        assert_eq!(pic.pixels[0][3], 0.0, "{compute:?}: a corner is outside the sphere");
+    }
+}
+
+/// The same bake on the application's device and on the CPU, read back from the textures:
+/// within 2 half-float ULPs (2⁻¹⁰ relative, above a floor of 10⁻³ of the largest value),
+/// the quantisation of the halves around GPU-vs-CPU f32 differences of about 10⁻⁵.
+#[test]
+fn textures_baked_on_the_device_match_those_baked_on_the_cpu() {
+    let (d, q) = device();
+    let env = splitsum::environment::embedded_default().unwrap();
+    let s = small();
+    let gpu = Baker::new(d, q, Compute::Gpu).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
+    let cpu = Baker::new(d, q, Compute::Cpu).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
+    let compare = |what: &str, a: &[Vec4], b: &[Vec4]| {
+        assert_eq!(a.len(), b.len(), "{what}");
+        let peak = b.iter().map(|v| v.max_element()).fold(0.0f32, f32::max);
+        let floor = 1e-3 * peak;
+        let worst = a.iter().zip(b).map(|(x, y)| ((*x - *y).abs() / y.abs().max(Vec4::splat(floor))).max_element()).fold(0.0f32, f32::max);
+        assert!(worst <= 2.0f32.powi(-10), "{what}: GPU and CPU textures differ by {worst:.2e} relative");
+    };
+    assert_eq!(gpu.specular.layout.levels, s.mips, "a mip per roughness");
+    compare("specular", &gpu.specular.texels, &cpu.specular.texels);
+    compare("irradiance", &gpu.irradiance.texels, &cpu.irradiance.texels);
+    compare("brdf", &gpu.brdf, &cpu.brdf);
+    // The table's own values against the f64 reference, as read from the texture.
+    let n = s.lut_size as usize;
+    for (x, y) in [(n - 1, n / 2), (n / 4, n / 8), (n / 2, n - 1)] {
+        let (nv, r) = ((x as f64 + 0.5) / n as f64, (y as f64 + 0.5) / n as f64);
+        let (a, b) = reference::brdf_lut_with(nv, r, 1e-9, reference::Smith::Correlated);
+        let t = gpu.brdf[y * n + x];
+        assert!((t.x as f64 - a).abs() < 2e-3 && (t.y as f64 - b).abs() < 2e-3, "table at n·v {nv}, r {r}: {t:?} vs ({a}, {b}) (half floats: 2⁻¹¹ of 1)");
+    }
+}
+
+/// A half-float overflow: a sun of 10⁶ in a texel is clamped to 65504 in the halves, never
+/// ∞ (an ∞ would turn every filtered lookup that touches it into ∞ or NaN).
+#[test]
+fn a_sun_beyond_half_floats_stays_finite_in_the_textures() {
+    let (d, q) = device();
+    let mut texels = vec![Vec4::new(0.1, 0.1, 0.1, 1.0); 64 * 32];
+    texels[10 * 64 + 20] = Vec4::new(1e6, 1e6, 1e6, 1.0);
+    let env = Environment::Equirect(Equirect { width: 64, height: 32, texels });
+    for compute in [Compute::Gpu, Compute::Cpu] {
+        let data = Baker::new(d, q, compute).unwrap().bake(Source::Environment(&env), &small()).unwrap().read(d, q).unwrap();
+        let max = data.specular.texels.iter().map(|v| v.max_element()).fold(0.0f32, f32::max);
+        assert!(data.specular.texels.iter().all(|v| v.is_finite()), "{compute:?}: every texel finite");
+        assert_eq!(max, 65504.0, "{compute:?}: the sun's mirror texel is clamped to the largest half");
+    }
+}
+
+/// A source given as the application's texture (RGBA32F equirect, and an RGBA16F cube)
+/// bakes what the same texels given as host data bake: the texture route reads exactly the
+/// texels (halves are exact in f32).
+#[test]
+fn a_texture_source_bakes_what_the_same_host_data_bakes() {
+    let (d, q) = device();
+    let env = splitsum::environment::embedded_default().unwrap();
+    let Environment::Equirect(e) = &env else { panic!("an equirect") };
+    let s = small();
+    let upload = |width: u32, height: u32, layers: u32, format: wgpu::TextureFormat, bytes: &[u8]| {
+        let t = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("app texture"),
+            size: wgpu::Extent3d { width, height, depth_or_array_layers: layers },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let texel = format.block_copy_size(None).unwrap();
+        q.write_texture(
+            t.as_image_copy(),
+            bytes,
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(width * texel), rows_per_image: Some(height) },
+            t.size(),
+        );
+        t
+    };
+    let baker = Baker::new(d, q, Compute::Gpu).unwrap();
+    let equirect = upload(e.width, e.height, 1, wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&e.texels));
+    let from_texture = baker.bake(Source::Texture(&equirect), &s).unwrap().read(d, q).unwrap();
+    let from_host = baker.bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
+    assert_eq!(from_texture.specular.texels, from_host.specular.texels, "equirect texture vs host data");
+    assert_eq!(from_texture.irradiance.texels, from_host.irradiance.texels);
+
+    // A cube of halves, on both backends.
+    let face = 32u32;
+    let cube = support::cube_from_fn(face, |dir| Vec4::new(1.0 + dir.x, 1.0 + dir.y, 1.0 + dir.z, 1.0));
+    let level0: Vec<half::f16> = cube.level(0).iter().flat_map(|v| v.to_array()).map(half::f16::from_f32).collect();
+    let exact: Vec<Vec4> = level0.chunks(4).map(|c| Vec4::new(c[0].to_f32(), c[1].to_f32(), c[2].to_f32(), c[3].to_f32())).collect();
+    let host = Environment::Cube(Cube { layout: splitsum_shaders::cubemap::CubeLayout::new(face, 1), texels: exact });
+    let bits: Vec<u16> = level0.iter().map(|h| h.to_bits()).collect();
+    let texture = upload(face, face, 6, wgpu::TextureFormat::Rgba16Float, bytemuck::cast_slice(&bits));
+    for compute in [Compute::Gpu, Compute::Cpu] {
+        let baker = Baker::new(d, q, compute).unwrap();
+        let a = baker.bake(Source::Texture(&texture), &s).unwrap().read(d, q).unwrap();
+        let b = baker.bake(Source::Environment(&host), &s).unwrap().read(d, q).unwrap();
+        assert_eq!(a.specular.texels, b.specular.texels, "{compute:?}: cube texture vs host data");
+        assert_eq!(a.irradiance.texels, b.irradiance.texels, "{compute:?}");
+    }
+}
+
+/// What the library refuses, in its own terms.
+#[test]
+fn the_library_says_what_is_wrong_in_its_own_terms() {
+    let (d, q) = device();
+    let baker = Baker::new(d, q, Compute::Cpu).unwrap();
+    let e = baker.bake(Source::Environment(&constant(1.0)), &Settings { size: 48, ..Settings::default() }).err().expect("48 is no power of two").to_string();
+    assert_eq!(e, "size must be a power of two from 1 to 4096, not 48");
+    let odd = d.create_texture(&wgpu::TextureDescriptor {
+        label: None,
+        size: wgpu::Extent3d { width: 30, height: 20, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let e = baker.bake(Source::Texture(&odd), &small()).err().expect("not an equirect").to_string();
+    assert!(e.contains("30×20") && e.contains("equirect"), "{e}");
+}

@@ -1,0 +1,270 @@
+//! `xtask spirv [--check]`: compiles `shaders/` to SPIR-V with rust-gpu and writes
+//! `spirv/src/splitsum_shaders.spv` and `spirv/src/linkage.rs`, the entry points'
+//! names, stages, workgroup sizes and bindings reflected from the module itself.
+//! `--check` compiles and compares instead, failing if either committed file differs.
+//!
+//! This is the only place rust-gpu runs: the workspace builds on stable from the committed
+//! files (renderling's pattern: committed SPIR-V with generated linkage, regenerated and
+//! diffed by CI).
+
+use rspirv::dr::{Instruction, Module, Operand};
+use rspirv::spirv::{Decoration, Dim, ExecutionMode, ExecutionModel, Op, StorageClass};
+use spirv_builder::{ShaderPanicStrategy, SpirvBuilder};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+type Error = Box<dyn std::error::Error>;
+
+fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let check = match args.iter().map(String::as_str).collect::<Vec<_>>().as_slice() {
+        ["spirv"] => false,
+        ["spirv", "--check"] => true,
+        _ => {
+            eprintln!("usage: xtask spirv [--check]");
+            return ExitCode::from(2);
+        }
+    };
+    match run(check) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::FAILURE,
+        Err(e) => {
+            eprintln!("xtask: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("xtask lives in the repository").to_path_buf()
+}
+
+fn run(check: bool) -> Result<bool, Error> {
+    let root = root();
+    let mut builder = SpirvBuilder::new(root.join("shaders"), "spirv-unknown-vulkan1.1");
+    builder.shader_panic_strategy = ShaderPanicStrategy::SilentExit;
+    builder.release = true;
+    let result = builder.build()?;
+    let spv = std::fs::read(result.module.unwrap_single())?;
+    let words: Vec<u32> = spv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    let module = rspirv::dr::load_words(&words).map_err(|e| format!("reading the module back: {e}"))?;
+    let linkage = linkage(&module)?;
+
+    let outputs = [(root.join("spirv/src/splitsum_shaders.spv"), spv), (root.join("spirv/src/linkage.rs"), linkage.into_bytes())];
+    let mut same = true;
+    for (path, bytes) in &outputs {
+        let shown = path.strip_prefix(&root).unwrap_or(path).display();
+        if check {
+            if std::fs::read(path).ok().as_deref() != Some(bytes.as_slice()) {
+                eprintln!("xtask: {shown} differs from what shaders/ compiles to; run `bash scripts/dev.sh spirv` and commit it");
+                same = false;
+            } else {
+                eprintln!("xtask: {shown} is up to date");
+            }
+        } else {
+            std::fs::write(path, bytes)?;
+            eprintln!("xtask: wrote {shown}");
+        }
+    }
+    Ok(same)
+}
+
+/// What a binding holds, as `splitsum_spirv::Resource` spells it.
+fn resource(module: &Module, var: &Instruction, written: bool) -> Result<String, Error> {
+    let types: HashMap<u32, &Instruction> = module.types_global_values.iter().filter_map(|i| i.result_id.map(|id| (id, i))).collect();
+    let class = match var.operands.first() {
+        Some(Operand::StorageClass(c)) => *c,
+        _ => return Err("a variable without a storage class".into()),
+    };
+    let pointee = |ty: u32| -> Option<&Instruction> {
+        let ptr = types.get(&ty)?;
+        match ptr.operands.get(1) {
+            Some(Operand::IdRef(t)) => types.get(t).copied(),
+            _ => None,
+        }
+    };
+    Ok(match class {
+        StorageClass::Uniform => "Resource::Uniform".into(),
+        StorageClass::StorageBuffer => format!("Resource::Storage {{ read_only: {} }}", !written),
+        StorageClass::UniformConstant => {
+            let mut ty = pointee(var.result_type.ok_or("untyped variable")?).ok_or("unknown variable type")?;
+            if ty.class.opcode == Op::TypeSampledImage {
+                match ty.operands.first() {
+                    Some(Operand::IdRef(t)) => ty = types[t],
+                    _ => return Err("a sampled image without an image type".into()),
+                }
+            }
+            match ty.class.opcode {
+                Op::TypeSampler => "Resource::Sampler".into(),
+                Op::TypeImage => {
+                    let dim = match ty.operands.get(1) {
+                        Some(Operand::Dim(Dim::Dim2D)) => "D2",
+                        Some(Operand::Dim(Dim::DimCube)) => "Cube",
+                        Some(Operand::Dim(Dim::Dim3D)) => "D3",
+                        Some(Operand::Dim(Dim::Dim1D)) => "D1",
+                        d => return Err(format!("an image of dimension {d:?}").into()),
+                    };
+                    let arrayed = matches!(ty.operands.get(3), Some(Operand::LiteralBit32(1)));
+                    let dim = if arrayed { format!("{dim}Array") } else { dim.to_string() };
+                    format!("Resource::Texture {{ dimension: Dimension::{dim} }}")
+                }
+                op => return Err(format!("a UniformConstant binding of type {op:?}").into()),
+            }
+        }
+        c => return Err(format!("a descriptor in storage class {c:?}").into()),
+    })
+}
+
+/// The ids each function refers to, and the functions it calls.
+fn function_uses(module: &Module) -> HashMap<u32, (BTreeSet<u32>, BTreeSet<u32>)> {
+    let mut uses = HashMap::new();
+    for f in &module.functions {
+        let Some(id) = f.def.as_ref().and_then(|d| d.result_id) else { continue };
+        let (mut refs, mut calls) = (BTreeSet::new(), BTreeSet::new());
+        for i in f.blocks.iter().flat_map(|b| &b.instructions) {
+            for o in &i.operands {
+                if let Operand::IdRef(r) = o {
+                    refs.insert(*r);
+                }
+            }
+            if i.class.opcode == Op::FunctionCall
+                && let Some(Operand::IdRef(callee)) = i.operands.first()
+            {
+                calls.insert(*callee);
+            }
+        }
+        uses.insert(id, (refs, calls));
+    }
+    uses
+}
+
+/// The global variables some store or atomic writes through, following access chains.
+fn written_variables(module: &Module) -> BTreeSet<u32> {
+    let mut root: HashMap<u32, u32> = HashMap::new();
+    for v in module.types_global_values.iter().filter(|i| i.class.opcode == Op::Variable) {
+        if let Some(id) = v.result_id {
+            root.insert(id, id);
+        }
+    }
+    let mut written = BTreeSet::new();
+    // Access chains may appear before the stores that use them; two passes settle them.
+    for _ in 0..2 {
+        for i in module.functions.iter().flat_map(|f| &f.blocks).flat_map(|b| &b.instructions) {
+            let first = match i.operands.first() {
+                Some(Operand::IdRef(r)) => Some(*r),
+                _ => None,
+            };
+            match i.class.opcode {
+                Op::AccessChain | Op::InBoundsAccessChain | Op::PtrAccessChain | Op::InBoundsPtrAccessChain | Op::CopyObject | Op::Bitcast => {
+                    if let (Some(base), Some(id)) = (first.and_then(|b| root.get(&b).copied()), i.result_id) {
+                        root.insert(id, base);
+                    }
+                }
+                Op::Store | Op::CopyMemory | Op::AtomicStore | Op::AtomicExchange | Op::AtomicIAdd | Op::AtomicISub | Op::AtomicOr | Op::AtomicAnd => {
+                    // The pointer written through is the first operand of each of these.
+                    if let Some(r) = first.and_then(|t| root.get(&t)) {
+                        written.insert(*r);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    written
+}
+
+/// `spirv/src/linkage.rs`: every entry point with its stage, workgroup size and the
+/// bindings its call tree uses.
+fn linkage(module: &Module) -> Result<String, Error> {
+    let mut decorations: HashMap<u32, (Option<u32>, Option<u32>)> = HashMap::new();
+    for a in module.annotations.iter().filter(|a| a.class.opcode == Op::Decorate) {
+        let (Some(Operand::IdRef(target)), Some(Operand::Decoration(d))) = (a.operands.first(), a.operands.get(1)) else { continue };
+        let value = match a.operands.get(2) {
+            Some(Operand::LiteralBit32(v)) => *v,
+            _ => continue,
+        };
+        let entry = decorations.entry(*target).or_default();
+        match d {
+            Decoration::DescriptorSet => entry.0 = Some(value),
+            Decoration::Binding => entry.1 = Some(value),
+            _ => {}
+        }
+    }
+    let variables: HashMap<u32, &Instruction> = module
+        .types_global_values
+        .iter()
+        .filter(|i| i.class.opcode == Op::Variable)
+        .filter_map(|i| i.result_id.map(|id| (id, i)))
+        .collect();
+    let mut local_size: HashMap<u32, [u32; 3]> = HashMap::new();
+    for m in &module.execution_modes {
+        if let (Some(Operand::IdRef(f)), Some(Operand::ExecutionMode(ExecutionMode::LocalSize))) = (m.operands.first(), m.operands.get(1)) {
+            let lit = |k: usize| match m.operands.get(k) {
+                Some(Operand::LiteralBit32(v)) => *v,
+                _ => 1,
+            };
+            local_size.insert(*f, [lit(2), lit(3), lit(4)]);
+        }
+    }
+    let uses = function_uses(module);
+    let written = written_variables(module);
+
+    let mut entries = BTreeMap::new();
+    for e in &module.entry_points {
+        let (Some(Operand::ExecutionModel(model)), Some(Operand::IdRef(f)), Some(Operand::LiteralString(name))) =
+            (e.operands.first(), e.operands.get(1), e.operands.get(2))
+        else {
+            return Err("a malformed OpEntryPoint".into());
+        };
+        let stage = match model {
+            ExecutionModel::GLCompute => "Compute",
+            ExecutionModel::Vertex => "Vertex",
+            ExecutionModel::Fragment => "Fragment",
+            m => return Err(format!("entry point {name} has execution model {m:?}").into()),
+        };
+        // Every id the entry point's call tree refers to, so that each entry point lists
+        // only the bindings it uses.
+        let (mut seen, mut todo, mut refs) = (BTreeSet::new(), vec![*f], BTreeSet::new());
+        while let Some(g) = todo.pop() {
+            if !seen.insert(g) {
+                continue;
+            }
+            if let Some((r, c)) = uses.get(&g) {
+                refs.extend(r.iter().copied());
+                todo.extend(c.iter().copied());
+            }
+        }
+        let mut bindings = BTreeMap::new();
+        for r in refs {
+            let (Some(var), Some((Some(group), Some(binding)))) = (variables.get(&r), decorations.get(&r)) else { continue };
+            bindings.insert((*group, *binding), resource(module, var, written.contains(&r))?);
+        }
+        entries.insert(name.clone(), (stage, local_size.get(f).copied().unwrap_or([1, 1, 1]), bindings));
+    }
+
+    let mut out = String::from(
+        "// @generated by `bash scripts/dev.sh spirv` (xtask/src/main.rs), reflected from\n\
+         // splitsum_shaders.spv. Do not edit: change shaders/ and regenerate.\n\n\
+         use crate::{Binding, Dimension, EntryPoint, Resource, Stage};\n",
+    );
+    let mut compute = Vec::new();
+    for (name, (stage, size, bindings)) in &entries {
+        let ident = name.replace("::", "_").to_uppercase();
+        let _ = write!(out, "\n/// `{name}`.\npub const {ident}: EntryPoint = EntryPoint {{\n    name: \"{name}\",\n    stage: Stage::{stage},\n    workgroup_size: {size:?},\n    bindings: &[\n");
+        for ((group, binding), resource) in bindings {
+            let _ = writeln!(out, "        Binding {{ group: {group}, binding: {binding}, resource: {resource} }},");
+        }
+        out.push_str("    ],\n};\n");
+        if *stage == "Compute" {
+            compute.push(ident);
+        }
+    }
+    let _ = write!(out, "\n/// Every compute entry point.\npub const KERNELS: [EntryPoint; {}] = [{}];\n", compute.len(), compute.join(", "));
+    if out.contains("Dimension::") {
+        Ok(out)
+    } else {
+        Ok(out.replace("Binding, Dimension, EntryPoint", "Binding, EntryPoint"))
+    }
+}
