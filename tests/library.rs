@@ -66,6 +66,7 @@ fn textures_baked_on_the_device_match_those_baked_on_the_cpu() {
         let peak = b.iter().map(|v| v.max_element()).fold(0.0f32, f32::max);
         let floor = 1e-3 * peak;
         let worst = a.iter().zip(b).map(|(x, y)| ((*x - *y).abs() / y.abs().max(Vec4::splat(floor))).max_element()).fold(0.0f32, f32::max);
+        eprintln!("{what}: GPU vs CPU textures, largest relative difference {worst:.2e}");
         assert!(worst <= 2.0f32.powi(-10), "{what}: GPU and CPU textures differ by {worst:.2e} relative");
     };
     assert_eq!(gpu.specular.layout.levels, s.mips, "a mip per roughness");

@@ -3,8 +3,9 @@
 
 use splitsum::Backend;
 use splitsum_display::render::{GpuScene, ViewState, render_cpu};
+use splitsum_shaders::choice::Choice;
 use splitsum_shaders::glam::Vec4;
-use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
+use splitsum_shaders::shade::{DiffuseModel, FresnelForm, ShadeOptions, SpecularModel};
 
 fn diff(a: &[Vec4], b: &[Vec4]) -> (f32, usize) {
     let mut worst = 0.0f32;
@@ -47,9 +48,9 @@ fn worst_gpu_vs_cpu(views: impl IntoIterator<Item = ViewState>) -> f32 {
 #[test]
 fn gpu_matches_the_cpu_reference() {
     let mut views = Vec::new();
-    for diffuse in 0..diffuse_model::COUNT {
-        for specular in 0..specular_model::COUNT {
-            for fresnel in 0..fresnel_model::COUNT {
+    for diffuse in 0..(DiffuseModel::ALL.len() as u32) {
+        for specular in 0..(SpecularModel::ALL.len() as u32) {
+            for fresnel in 0..(FresnelForm::ALL.len() as u32) {
                 views.push(ViewState {
                     options: ShadeOptions { diffuse, specular, fresnel, flags: ShadeOptions::IBL | ShadeOptions::DIRECT },
                     sky_blur: 1.3,
@@ -61,7 +62,7 @@ fn gpu_matches_the_cpu_reference() {
     let worst_all = worst_gpu_vs_cpu(views);
     println!(
         "scene 96×64, all {} model combinations: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)",
-        diffuse_model::COUNT * specular_model::COUNT * fresnel_model::COUNT
+        (DiffuseModel::ALL.len() as u32) * (SpecularModel::ALL.len() as u32) * (FresnelForm::ALL.len() as u32)
     );
     // lavapipe 2.4e-7; an H100 5.4e-5 (sphere silhouettes, where shading is steep in the
     // hit point; see `support::gpu_bound`), 1.4e-3 before the ray–sphere discriminant was

@@ -7,7 +7,7 @@ use splitsum::Backend;
 use splitsum::texture::Cube;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::glam::{Vec3, Vec4};
-use splitsum_shaders::kernels::{ProbeParams, probe_mode};
+use splitsum_shaders::kernels::{ProbeMode, ProbeParams};
 use splitsum_shaders::math::MAX_RADIANCE;
 
 const ROUGHNESS: [f32; 5] = [0.0, 1e-7, 1e-4, 0.02, 1.0];
@@ -50,7 +50,7 @@ fn lut_corners_of_the_domain() {
             } else {
                 N_DOT_V.iter().flat_map(|&nv| ROUGHNESS.iter().map(move |&r| Vec4::new(nv, r, 0.0, 0.0))).collect()
             };
-            let out = b.probe(params(probe_mode::LUT, samples), None, &probes).unwrap();
+            let out = b.probe(params(ProbeMode::Lut as u32, samples), None, &probes).unwrap();
             for (q, v) in probes.iter().zip(&out) {
                 assert!(v.x.is_finite() && v.y.is_finite(), "{}: n·v {} r {} n {samples}: {v}", b.describe(), q.x, q.y);
                 assert!(v.x >= 0.0 && v.y >= 0.0, "{}: {q} {v}", b.describe());
@@ -90,15 +90,15 @@ fn constant_environments_stay_constant_everywhere() {
             };
             for samples in [1u32, 2, 256] {
                 let probes: Vec<Vec4> = dirs.iter().flat_map(|d| ROUGHNESS.iter().map(move |&r| d.extend(r))).collect();
-                let out = b.probe(params(probe_mode::PREFILTER, samples), Some(&cube), &probes).unwrap();
+                let out = b.probe(params(ProbeMode::Prefilter as u32, samples), Some(&cube), &probes).unwrap();
                 probes.iter().zip(&out).for_each(|(q, v)| check("prefilter", q, v));
             }
             let probes: Vec<Vec4> = dirs.iter().map(|d| d.extend(0.0)).collect();
-            let p = ProbeParams { src_level: 1, ..params(probe_mode::IRRADIANCE, 0) };
+            let p = ProbeParams { src_level: 1, ..params(ProbeMode::Irradiance as u32, 0) };
             let out = b.probe(p, Some(&cube), &probes).unwrap();
             probes.iter().zip(&out).for_each(|(q, v)| check("irradiance", q, v));
             let probes: Vec<Vec4> = dirs.iter().flat_map(|d| [-2.0f32, 0.0, 0.5, 1.7, 3.0, 40.0].map(|l| d.extend(l))).collect();
-            let out = b.probe(params(probe_mode::SAMPLE, 0), Some(&cube), &probes).unwrap();
+            let out = b.probe(params(ProbeMode::Sample as u32, 0), Some(&cube), &probes).unwrap();
             probes.iter().zip(&out).for_each(|(q, v)| check("sample", q, v));
         }
     }
@@ -116,9 +116,9 @@ fn shading_is_finite_at_the_extremes() {
             for metallic in [0.0f32, 1.0] {
                 for &radiance in &[0.0f32, 1e-40, 1e4, 1e6, MAX_RADIANCE] {
                     let m = Material { base_color: Vec3::ONE, metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
-                    for diffuse in 0..shade::diffuse_model::COUNT {
-                        for specular in 0..shade::specular_model::COUNT {
-                            for fresnel in 0..shade::fresnel_model::COUNT {
+                    for diffuse in 0..(<shade::DiffuseModel as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
+                        for specular in 0..(<shade::SpecularModel as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
+                            for fresnel in 0..(<shade::FresnelForm as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
                                 let o = ShadeOptions { diffuse, specular, fresnel, flags: 3 };
                                 for l in [n, v, Vec3::new(-v.x, 0.0, v.z), Vec3::new(0.0, 1.0, 1e-7).normalize()] {
                                     let c = shade::direct(o, &m, n, v, l, Vec3::splat(radiance));
@@ -210,13 +210,13 @@ fn extreme_environment_bakes_and_renders_finite() {
 fn long_sums_survive_the_gpu_loop_budget() {
     let probes = vec![Vec4::new(0.5, 0.5, 0.0, 0.0), Vec4::new(0.01, 0.1, 0.0, 0.0), Vec4::new(0.9, 0.05, 0.0, 0.0)];
     let n = 1 << 20;
-    let g = support::gpu().probe(params(probe_mode::LUT, n), None, &probes).unwrap();
-    let c = Backend::Cpu.probe(params(probe_mode::LUT, n), None, &probes).unwrap();
+    let g = support::gpu().probe(params(ProbeMode::Lut as u32, n), None, &probes).unwrap();
+    let c = Backend::Cpu.probe(params(ProbeMode::Lut as u32, n), None, &probes).unwrap();
     let lut = support::max_diffs(g.iter().flat_map(|v| [v.x, v.y]), c.iter().flat_map(|v| [v.x, v.y])).0;
     let src = support::source_cube("city", 32);
     let dirs: Vec<Vec4> = (0..16).map(|i| splitsum_shaders::equirect::uv_to_dir(splitsum_shaders::sampling::hammersley(i, 16)).extend(0.6)).collect();
-    let g = support::gpu().probe(params(probe_mode::PREFILTER, 40_000), Some(&src), &dirs).unwrap();
-    let c = Backend::Cpu.probe(params(probe_mode::PREFILTER, 40_000), Some(&src), &dirs).unwrap();
+    let g = support::gpu().probe(params(ProbeMode::Prefilter as u32, 40_000), Some(&src), &dirs).unwrap();
+    let c = Backend::Cpu.probe(params(ProbeMode::Prefilter as u32, 40_000), Some(&src), &dirs).unwrap();
     let pre = support::max_relative(&g, &c, 1e-3);
     println!("gpu vs cpu: BRDF table at 2^20 samples max |Δ| {lut:.2e}; prefilter at 40 000 samples max relative {pre:.2e}");
     assert!(lut < 1e-5 && pre < 1e-5, "{lut:e} {pre:e}");

@@ -19,11 +19,12 @@
 //!   the end-to-end measure's: the share of the shaded colour's error the bake adds, in the
 //!   roughness bands the scene reads (`accuracy`, part (a)).
 
-use crate::scene::{MaterialSpec, Scene, SpecularArg};
+use crate::scene::{MaterialSpec, Scene};
 use serde::Serialize;
 use splitsum::cost::{Calibration, Cost, estimate};
 use splitsum::settings::{Products, Settings, TableMethod};
 use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_shaders::shade::SpecularModel;
 
 /// One decision of the plan.
 #[derive(Clone, Debug, Serialize)]
@@ -78,8 +79,8 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     let mut decide = |what: &str, kept: bool, why: String| d.push(Decision { what: what.into(), kept, why });
     let used = scene.used_materials();
     let lit: Vec<&MaterialSpec> = used.iter().copied().filter(|m| m.ibl).collect();
-    let specular_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.specular != SpecularArg::None).collect();
-    let ggx: Vec<&MaterialSpec> = specular_ibl.iter().copied().filter(|m| m.specular == SpecularArg::CookTorrance).collect();
+    let specular_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.specular != SpecularModel::None).collect();
+    let ggx: Vec<&MaterialSpec> = specular_ibl.iter().copied().filter(|m| m.specular == SpecularModel::CookTorrance).collect();
     let diffuse_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.metallic.range().0 < 1.0).collect();
     let names = |v: &[&MaterialSpec]| v.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(", ");
 

@@ -7,9 +7,10 @@ use rayon::prelude::*;
 use splitsum::backend::gpu::{Gpu, group_layout};
 use splitsum::bake::BakedEnvironment;
 use splitsum::error::{Error, Result};
+use splitsum_shaders::choice::Choice;
 use splitsum_shaders::glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
 use splitsum_shaders::scene::{self, Frame, Light, MAX_LIGHTS};
-use splitsum_shaders::shade::{EnvironmentShape, ShadeOptions, diffuse_model, fresnel_model, specular_model};
+use splitsum_shaders::shade::{DiffuseModel, EnvironmentShape, FresnelForm, ShadeOptions, SpecularModel};
 use splitsum_shaders::tonemap::Tonemapper;
 use splitsum_spirv::{self as spirv, EntryPoint};
 use wgpu::util::DeviceExt;
@@ -77,39 +78,6 @@ impl Default for ViewState {
     }
 }
 
-/// Names of the models, for titles and reports.
-pub fn diffuse_name(code: u32) -> &'static str {
-    match code {
-        diffuse_model::OREN_NAYAR => "Oren-Nayar",
-        diffuse_model::FRESNEL_WEIGHTED => "Fresnel-weighted",
-        _ => "Lambert",
-    }
-}
-
-/// Name of a specular model.
-pub fn specular_name(code: u32) -> &'static str {
-    match code {
-        specular_model::PHONG => "Phong",
-        specular_model::BLINN_PHONG => "Blinn-Phong",
-        specular_model::NONE => "none",
-        _ => "Cook-Torrance",
-    }
-}
-
-/// Name of a Fresnel form.
-pub fn fresnel_name(code: u32) -> &'static str {
-    if code == fresnel_model::SPHERICAL_GAUSSIAN { "spherical Gaussian" } else { "Schlick" }
-}
-
-/// Name of a tone curve.
-pub fn tonemapper_name(t: Tonemapper) -> &'static str {
-    match t {
-        Tonemapper::Aces => "ACES",
-        Tonemapper::Reinhard => "Reinhard",
-        Tonemapper::Clamp => "clamp",
-    }
-}
-
 impl ViewState {
     /// Points the camera at what is shown: the grid, the model beside it, or both.
     pub fn frame_contents(&mut self) {
@@ -147,14 +115,14 @@ impl ViewState {
         let o = self.options;
         format!(
             "diffuse {} | specular {} | Fresnel {} | IBL {}{} | lights {} | exposure {:.2} | {} | sky blur {:.1}{}",
-            diffuse_name(o.diffuse),
-            specular_name(o.specular),
-            fresnel_name(o.fresnel),
+            DiffuseModel::from_code(o.diffuse).name(),
+            SpecularModel::from_code(o.specular).name(),
+            FresnelForm::from_code(o.fresnel).name(),
             if o.flags & ShadeOptions::IBL != 0 { "on" } else { "off" },
             ibl_options(o.flags),
             if o.flags & ShadeOptions::DIRECT != 0 { "on" } else { "off" },
             self.exposure,
-            tonemapper_name(self.tonemapper),
+            self.tonemapper.name(),
             self.sky_blur,
             match (self.spheres, self.show_model) {
                 (true, true) => " | grid + model",

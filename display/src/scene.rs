@@ -46,123 +46,10 @@
 
 use serde::{Deserialize, Serialize};
 use splitsum::error::{Error, Result};
-use splitsum_shaders::choice::Choice;
-use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
+use splitsum::settings::named;
+use splitsum_shaders::shade::{DiffuseModel, FresnelForm, ShadeOptions, SpecularModel};
 use splitsum_shaders::tonemap::Tonemapper;
 use std::path::{Path, PathBuf};
-
-/// Diffuse models.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum DiffuseArg {
-    /// ρ/π.
-    #[default]
-    Lambert,
-    /// Oren–Nayar, σ = roughness.
-    OrenNayar,
-    /// Ashikhmin–Shirley's Fresnel-weighted diffuse.
-    FresnelWeighted,
-}
-
-/// Specular models.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum SpecularArg {
-    /// GGX, Smith–Schlick, Fresnel.
-    #[default]
-    CookTorrance,
-    /// Normalised Phong.
-    Phong,
-    /// Normalised Blinn–Phong.
-    BlinnPhong,
-    /// No specular.
-    None,
-}
-
-/// Fresnel forms.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum FresnelArg {
-    /// Schlick.
-    #[default]
-    Schlick,
-    /// UE4's spherical Gaussian.
-    SphericalGaussian,
-}
-
-/// Tone curves.
-#[derive(Copy, Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum TonemapArg {
-    /// Narkowicz's ACES fit.
-    #[default]
-    Aces,
-    /// Reinhard.
-    Reinhard,
-    /// Clamp.
-    Clamp,
-}
-
-macro_rules! choices {
-    ($t:ty: $($v:ident => $n:literal),+) => {
-        impl Choice for $t {
-            const ALL: &'static [Self] = &[$(<$t>::$v),+];
-            fn name(self) -> &'static str {
-                match self {
-                    $(<$t>::$v => $n,)+
-                }
-            }
-        }
-    };
-}
-choices!(DiffuseArg: Lambert => "lambert", OrenNayar => "oren-nayar", FresnelWeighted => "fresnel-weighted");
-choices!(SpecularArg: CookTorrance => "cook-torrance", Phong => "phong", BlinnPhong => "blinn-phong", None => "none");
-choices!(FresnelArg: Schlick => "schlick", SphericalGaussian => "spherical-gaussian");
-choices!(TonemapArg: Aces => "aces", Reinhard => "reinhard", Clamp => "clamp");
-
-impl DiffuseArg {
-    /// The shader's code.
-    pub fn code(self) -> u32 {
-        match self {
-            DiffuseArg::Lambert => diffuse_model::LAMBERT,
-            DiffuseArg::OrenNayar => diffuse_model::OREN_NAYAR,
-            DiffuseArg::FresnelWeighted => diffuse_model::FRESNEL_WEIGHTED,
-        }
-    }
-}
-
-impl SpecularArg {
-    /// The shader's code.
-    pub fn code(self) -> u32 {
-        match self {
-            SpecularArg::CookTorrance => specular_model::COOK_TORRANCE,
-            SpecularArg::Phong => specular_model::PHONG,
-            SpecularArg::BlinnPhong => specular_model::BLINN_PHONG,
-            SpecularArg::None => specular_model::NONE,
-        }
-    }
-}
-
-impl FresnelArg {
-    /// The shader's code.
-    pub fn code(self) -> u32 {
-        match self {
-            FresnelArg::Schlick => fresnel_model::SCHLICK,
-            FresnelArg::SphericalGaussian => fresnel_model::SPHERICAL_GAUSSIAN,
-        }
-    }
-}
-
-impl TonemapArg {
-    /// The shader's curve.
-    pub fn curve(self) -> Tonemapper {
-        match self {
-            TonemapArg::Aces => Tonemapper::Aces,
-            TonemapArg::Reinhard => Tonemapper::Reinhard,
-            TonemapArg::Clamp => Tonemapper::Clamp,
-        }
-    }
-}
 
 /// A material parameter: a constant, a range `[a, b]` (the values the material takes
 /// somewhere, e.g. over a sphere grid or a texture), or `"texture"` (anything in [0, 1]).
@@ -204,14 +91,14 @@ pub struct MaterialSpec {
     #[serde(default = "half")]
     pub roughness: Param,
     /// Diffuse model.
-    #[serde(default)]
-    pub diffuse: DiffuseArg,
+    #[serde(default, with = "named")]
+    pub diffuse: DiffuseModel,
     /// Specular model.
-    #[serde(default)]
-    pub specular: SpecularArg,
+    #[serde(default, with = "named")]
+    pub specular: SpecularModel,
     /// Fresnel form.
-    #[serde(default)]
-    pub fresnel: FresnelArg,
+    #[serde(default, with = "named")]
+    pub fresnel: FresnelForm,
     /// Lit by the environment (image-based light).
     #[serde(default = "yes")]
     pub ibl: bool,
@@ -283,9 +170,9 @@ impl MaterialSpec {
     /// The shader options of this material (direct lights on).
     pub fn options(&self) -> ShadeOptions {
         ShadeOptions {
-            diffuse: self.diffuse.code(),
-            specular: self.specular.code(),
-            fresnel: self.fresnel.code(),
+            diffuse: self.diffuse as u32,
+            specular: self.specular as u32,
+            fresnel: self.fresnel as u32,
             flags: ShadingChoices {
                 mirror_direction: self.mirror_direction,
                 multiscatter: self.multiscatter,
@@ -425,7 +312,8 @@ pub struct DisplaySpec {
     /// Exposure in stops over the automatic one.
     pub exposure: f32,
     /// Tone curve.
-    pub tonemapper: TonemapArg,
+    #[serde(with = "named")]
+    pub tonemapper: Tonemapper,
 }
 
 /// A scene file.
@@ -522,8 +410,8 @@ impl Scene {
                 return bad(format!("[quality] {field} must be at least 1, not 0"));
             }
         }
-        if let Some(v) = q.lut_size.filter(|v| !(1..=splitsum::backend::MAX_LUT_SIZE).contains(v)) {
-            return bad(format!("[quality] lut_size must be from 1 to {}, not {v}", splitsum::backend::MAX_LUT_SIZE));
+        if let Some(v) = q.lut_size.filter(|v| !(1..=splitsum::settings::MAX_LUT_SIZE).contains(v)) {
+            return bad(format!("[quality] lut_size must be from 1 to {}, not {v}", splitsum::settings::MAX_LUT_SIZE));
         }
         for (field, v, max) in [("size", q.size, splitsum::settings::MAX_SIZE), ("irradiance_source", q.irradiance_source, 256)] {
             if let Some(v) = v.filter(|v| !v.is_power_of_two() || *v > max) {
@@ -577,7 +465,7 @@ impl Scene {
             pitch: self.camera.pitch.to_radians(),
             fov: self.camera.fov.to_radians(),
             exposure: auto_exposure * 2f32.powf(self.display.exposure),
-            tonemapper: self.display.tonemapper.curve(),
+            tonemapper: self.display.tonemapper,
             sky_blur: self.sky_blur,
             spheres: grid.is_some(),
             show_model: model.is_some(),

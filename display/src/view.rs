@@ -7,7 +7,8 @@ use crate::render::{GpuModel, GpuScene, ViewState};
 use splitsum::backend::gpu::Gpu;
 use splitsum::bake::BakedEnvironment;
 use splitsum::error::{Error, Result};
-use splitsum_shaders::shade::{ShadeOptions, diffuse_model, fresnel_model, specular_model};
+use splitsum_shaders::choice::Choice;
+use splitsum_shaders::shade::{DiffuseModel, FresnelForm, ShadeOptions, SpecularModel};
 use splitsum_shaders::tonemap::Tonemapper;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -146,9 +147,9 @@ impl App {
             Key::Named(NamedKey::Escape) => event_loop.exit(),
             Key::Character(c) => match c.to_lowercase().as_str() {
                 "q" => event_loop.exit(),
-                "d" => o.diffuse = (o.diffuse + 1) % diffuse_model::COUNT,
-                "s" => o.specular = (o.specular + 1) % specular_model::COUNT,
-                "f" => o.fresnel = (o.fresnel + 1) % fresnel_model::COUNT,
+                "d" => o.diffuse = (o.diffuse + 1) % DiffuseModel::ALL.len() as u32,
+                "s" => o.specular = (o.specular + 1) % SpecularModel::ALL.len() as u32,
+                "f" => o.fresnel = (o.fresnel + 1) % FresnelForm::ALL.len() as u32,
                 "i" => o.flags ^= ShadeOptions::IBL,
                 "l" => o.flags ^= ShadeOptions::DIRECT,
                 "+" | "=" => self.state.exposure *= std::f32::consts::SQRT_2,

@@ -1,8 +1,13 @@
 //! The one idiom for a closed set of choices that crosses between host and shader: a
-//! `#[repr(u32)]` enum defined here, whose `code` goes into parameter blocks (decoded with
-//! its `from_u32`, which maps unknown codes to a stated default) and whose [`Choice::name`]
-//! is what scene files, manifests and command-line flags spell. The host has no mirror
-//! types: it parses and prints these through [`Choice`].
+//! `#[repr(u32)]` enum defined once, whose [`Choice::code`] goes into parameter blocks
+//! (the shaders compare codes with `Enum::Variant as u32`) and whose [`Choice::name`] is
+//! what scene files, manifests and command-line flags spell. The host has no mirror types:
+//! it parses, prints and decodes these through [`Choice`].
+
+use crate::brdf::microfacet::Masking;
+use crate::prefilter::RoughnessMapping;
+use crate::shade::{DiffuseModel, FresnelForm, SpecularModel};
+use crate::tonemap::Tonemapper;
 
 /// A closed set of named choices.
 pub trait Choice: Copy + PartialEq + 'static {
@@ -12,44 +17,43 @@ pub trait Choice: Copy + PartialEq + 'static {
     /// The name files and flags spell.
     fn name(self) -> &'static str;
 
+    /// The code parameter blocks carry.
+    fn code(self) -> u32;
+
     /// The choice called `name`, if any.
     fn from_name(name: &str) -> Option<Self> {
         Self::ALL.iter().copied().find(|c| c.name() == name)
     }
-}
 
-use crate::brdf::microfacet::Masking;
-use crate::prefilter::RoughnessMapping;
-use crate::tonemap::Tonemapper;
-
-impl Choice for RoughnessMapping {
-    const ALL: &'static [Self] = &[Self::Linear, Self::Quadratic, Self::Geometric];
-    fn name(self) -> &'static str {
-        match self {
-            Self::Linear => "linear",
-            Self::Quadratic => "quadratic",
-            Self::Geometric => "geometric",
-        }
+    /// The choice whose code is `code`; unknown codes give the first choice, as the
+    /// shaders read them.
+    fn from_code(code: u32) -> Self {
+        Self::ALL.iter().copied().find(|c| c.code() == code).unwrap_or(Self::ALL[0])
     }
 }
 
-impl Choice for Masking {
-    const ALL: &'static [Self] = &[Self::SmithSchlick, Self::SmithCorrelated];
-    fn name(self) -> &'static str {
-        match self {
-            Self::SmithSchlick => "schlick",
-            Self::SmithCorrelated => "correlated",
+/// Implements [`Choice`] for a fieldless enum: its variants in code order, each with its
+/// name.
+#[macro_export]
+macro_rules! choice {
+    ($t:ty: $($v:ident => $n:literal),+ $(,)?) => {
+        impl $crate::choice::Choice for $t {
+            const ALL: &'static [Self] = &[$(<$t>::$v),+];
+            fn name(self) -> &'static str {
+                match self {
+                    $(<$t>::$v => $n,)+
+                }
+            }
+            fn code(self) -> u32 {
+                self as u32
+            }
         }
-    }
+    };
 }
 
-impl Choice for Tonemapper {
-    const ALL: &'static [Self] = &[Self::Aces, Self::Reinhard, Self::Clamp];
-    fn name(self) -> &'static str {
-        match self {
-            Self::Aces => "aces",
-            Self::Reinhard => "reinhard",
-            Self::Clamp => "clamp",
-        }
-    }
-}
+choice!(RoughnessMapping: Linear => "linear", Quadratic => "quadratic", Geometric => "geometric");
+choice!(Masking: SmithSchlick => "schlick", SmithCorrelated => "correlated");
+choice!(Tonemapper: Aces => "aces", Reinhard => "reinhard", Clamp => "clamp");
+choice!(DiffuseModel: Lambert => "lambert", OrenNayar => "oren-nayar", FresnelWeighted => "fresnel-weighted");
+choice!(SpecularModel: CookTorrance => "cook-torrance", Phong => "phong", BlinnPhong => "blinn-phong", None => "none");
+choice!(FresnelForm: Schlick => "schlick", SphericalGaussian => "spherical-gaussian");

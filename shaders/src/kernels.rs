@@ -277,23 +277,27 @@ pub fn irradiance_sh9(
     }
 }
 
-/// What [`probe`] evaluates.
-pub mod probe_mode {
+/// What [`probe`] evaluates (its code goes into [`ProbeParams::mode`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum ProbeMode {
     /// `lut::accumulate(n·v = q.x, roughness = q.y)`: the partial sums in `out[3i]`.
-    pub const LUT: u32 = 0;
+    Lut = 0,
     /// `prefilter::accumulate(dir = q.xyz, roughness = q.w)`: a `MeanPartial` in `out[3i..]`.
-    pub const PREFILTER: u32 = 1;
+    Prefilter = 1,
     /// `irradiance::accumulate(normal = q.xyz)` over level `src_level`: a `MeanPartial`.
-    pub const IRRADIANCE: u32 = 2;
+    Irradiance = 2,
     /// `cubemap::sample_lod(dir = q.xyz, lod = q.w)` in `out[3i]`.
-    pub const SAMPLE: u32 = 3;
+    Sample = 3,
 }
+
+crate::choice!(ProbeMode: Lut => "lut", Prefilter => "prefilter", Irradiance => "irradiance", Sample => "sample");
 
 /// Parameters of [`probe`].
 #[derive(Copy, Clone, Debug, Pod, Zeroable)]
 #[repr(C)]
 pub struct ProbeParams {
-    /// A [`probe_mode`] constant.
+    /// A [`ProbeMode`] code.
     pub mode: u32,
     /// Number of probes.
     pub count: u32,
@@ -320,12 +324,12 @@ pub struct ProbeParams {
 /// (or continues) three `Vec4` at `out[3i..]`.
 pub fn probe_chunk(p: &ProbeParams, input: &[Vec4], q: Vec4, out: &mut [Vec4], i: usize) {
     let layout = CubeLayout::new(p.src_size, p.src_levels);
-    if p.mode == probe_mode::LUT {
+    if p.mode == ProbeMode::Lut as u32 {
         out[3 * i] = lut::accumulate(q.x, q.y, p.samples, p.start, p.chunk, out[3 * i]);
-    } else if p.mode == probe_mode::PREFILTER {
+    } else if p.mode == ProbeMode::Prefilter as u32 {
         let partial = load_partial(out, i);
         store_partial(out, i, prefilter::accumulate(input, layout, q.truncate(), q.w, p.samples, p.start, p.chunk, p.lod_bias, partial));
-    } else if p.mode == probe_mode::IRRADIANCE {
+    } else if p.mode == ProbeMode::Irradiance as u32 {
         let partial = load_partial(out, i);
         store_partial(out, i, irradiance::accumulate(input, layout, p.src_level, q.truncate(), p.start, p.chunk, partial));
     } else {

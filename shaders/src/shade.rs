@@ -40,51 +40,54 @@ pub const MIN_DIRECT_ROUGHNESS: f32 = 0.02;
 /// which interpolated and normal-mapped normals produce, are shaded as grazing.
 pub const MIN_N_DOT_V: f32 = lut::MIN_N_DOT_V;
 
-/// Diffuse model.
-pub mod diffuse_model {
+/// Diffuse model (its code goes into [`ShadeOptions::diffuse`]).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+pub enum DiffuseModel {
     /// Lambert.
-    pub const LAMBERT: u32 = 0;
+    #[default]
+    Lambert = 0,
     /// Oren–Nayar with σ = roughness.
-    pub const OREN_NAYAR: u32 = 1;
+    OrenNayar = 1,
     /// Ashikhmin–Shirley's Fresnel-weighted diffuse.
-    pub const FRESNEL_WEIGHTED: u32 = 2;
-    /// Number of models.
-    pub const COUNT: u32 = 3;
+    FresnelWeighted = 2,
 }
 
-/// Specular model.
-pub mod specular_model {
+/// Specular model (its code goes into [`ShadeOptions::specular`]).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+pub enum SpecularModel {
     /// Cook–Torrance with GGX and Smith–Schlick.
-    pub const COOK_TORRANCE: u32 = 0;
+    #[default]
+    CookTorrance = 0,
     /// Normalised Phong.
-    pub const PHONG: u32 = 1;
+    Phong = 1,
     /// Normalised Blinn–Phong.
-    pub const BLINN_PHONG: u32 = 2;
+    BlinnPhong = 2,
     /// No specular term.
-    pub const NONE: u32 = 3;
-    /// Number of models.
-    pub const COUNT: u32 = 4;
+    None = 3,
 }
 
-/// Fresnel form.
-pub mod fresnel_model {
+/// Fresnel form (its code goes into [`ShadeOptions::fresnel`]).
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
+#[repr(u32)]
+pub enum FresnelForm {
     /// Schlick's `(1 − cos θ)⁵`.
-    pub const SCHLICK: u32 = 0;
+    #[default]
+    Schlick = 0,
     /// UE4's spherical Gaussian.
-    pub const SPHERICAL_GAUSSIAN: u32 = 1;
-    /// Number of forms.
-    pub const COUNT: u32 = 2;
+    SphericalGaussian = 1,
 }
 
 /// Which models and which light to use.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Pod, Zeroable)]
 #[repr(C)]
 pub struct ShadeOptions {
-    /// A [`diffuse_model`] constant.
+    /// A [`DiffuseModel`] code.
     pub diffuse: u32,
-    /// A [`specular_model`] constant.
+    /// A [`SpecularModel`] code.
     pub specular: u32,
-    /// A [`fresnel_model`] constant.
+    /// A [`FresnelForm`] code.
     pub fresnel: u32,
     /// Bit 0: image-based light on; bit 1: direct lights on.
     pub flags: u32,
@@ -114,9 +117,9 @@ impl ShadeOptions {
     /// dominant direction and the exact Smith term for direct lights (each measured closer
     /// to the full reflectance integral by `runner report`).
     pub const DEFAULT: ShadeOptions = ShadeOptions {
-        diffuse: diffuse_model::LAMBERT,
-        specular: specular_model::COOK_TORRANCE,
-        fresnel: fresnel_model::SCHLICK,
+        diffuse: DiffuseModel::Lambert as u32,
+        specular: SpecularModel::CookTorrance as u32,
+        fresnel: FresnelForm::Schlick as u32,
         flags: Self::IBL | Self::DIRECT | Self::DOMINANT_DIRECTION | Self::CORRELATED_SMITH,
     };
 }
@@ -153,13 +156,13 @@ impl Material {
 /// Fresnel at `cos_theta` in the chosen form.
 #[inline]
 pub fn fresnel(form: u32, f0: Vec3, cos_theta: f32) -> Vec3 {
-    if form == fresnel_model::SPHERICAL_GAUSSIAN { fresnel::spherical_gaussian3(f0, cos_theta) } else { fresnel::schlick3(f0, cos_theta) }
+    if form == FresnelForm::SphericalGaussian as u32 { fresnel::spherical_gaussian3(f0, cos_theta) } else { fresnel::schlick3(f0, cos_theta) }
 }
 
 /// The roughness-aware Fresnel of the ambient term in the chosen form.
 #[inline]
 pub fn fresnel_ambient(form: u32, f0: Vec3, n_dot_v: f32, roughness: f32) -> Vec3 {
-    if form == fresnel_model::SPHERICAL_GAUSSIAN {
+    if form == FresnelForm::SphericalGaussian as u32 {
         let g = Vec3::splat(1.0 - roughness).max(f0);
         f0 + (g - f0) * fresnel::spherical_gaussian_weight(n_dot_v)
     } else {
@@ -181,7 +184,7 @@ pub fn direct(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, l: Vec3, radia
     let f = fresnel(opts.fresnel, f0, v_dot_h);
     let r = math::max(m.roughness, MIN_DIRECT_ROUGHNESS);
     let alpha = alpha_from_roughness(r);
-    let specular = if opts.specular == specular_model::COOK_TORRANCE {
+    let specular = if opts.specular == SpecularModel::CookTorrance as u32 {
         let d = microfacet::d_ggx_vec(n, h, alpha);
         let vis = if opts.flags & ShadeOptions::CORRELATED_SMITH != 0 {
             microfacet::vis_smith_correlated(n_dot_v, n_dot_l, alpha)
@@ -189,20 +192,20 @@ pub fn direct(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, l: Vec3, radia
             microfacet::vis_smith_schlick(n_dot_v, n_dot_l, microfacet::k_direct(r))
         };
         f * (d * vis)
-    } else if opts.specular == specular_model::PHONG {
+    } else if opts.specular == SpecularModel::Phong as u32 {
         let refl = sampling::reflect(v, n);
         f * phong::phong(refl.dot(l), 0.25 * phong::blinn_exponent(alpha))
-    } else if opts.specular == specular_model::BLINN_PHONG {
+    } else if opts.specular == SpecularModel::BlinnPhong as u32 {
         f * phong::blinn_phong(n.dot(h), phong::blinn_exponent(alpha))
     } else {
         Vec3::ZERO
     };
     let no_metal = 1.0 - m.metallic;
-    let diffuse = if opts.diffuse == diffuse_model::FRESNEL_WEIGHTED {
+    let diffuse = if opts.diffuse == DiffuseModel::FresnelWeighted as u32 {
         diffuse::fresnel_weighted(m.base_color, f0, n_dot_l, n_dot_v) * no_metal
     } else {
         let kd = (Vec3::ONE - f) * no_metal;
-        if opts.diffuse == diffuse_model::OREN_NAYAR {
+        if opts.diffuse == DiffuseModel::OrenNayar as u32 {
             kd * diffuse::oren_nayar(m.base_color, m.roughness, n_dot_l, n_dot_v, l.dot(v))
         } else {
             kd * diffuse::lambert(m.base_color)
@@ -316,21 +319,24 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
     let f0 = m.f0();
     let f = fresnel_ambient(opts.fresnel, f0, n_dot_v, m.roughness);
     let no_metal = 1.0 - m.metallic;
-    let diffuse = if opts.diffuse == diffuse_model::FRESNEL_WEIGHTED {
+    let diffuse = if opts.diffuse == DiffuseModel::FresnelWeighted as u32 {
         let view = 1.0 - math::pow5(1.0 - 0.5 * n_dot_v);
         // (28/23)·(23/28): the light factor's cosine-weighted mean cancels the normalisation.
         m.base_color * (Vec3::ONE - f0) * (no_metal * view) * s.irradiance
     } else {
         (Vec3::ONE - f) * no_metal * m.base_color * s.irradiance
     };
-    if opts.specular == specular_model::COOK_TORRANCE && opts.flags & ShadeOptions::MULTISCATTER != 0 && opts.diffuse != diffuse_model::FRESNEL_WEIGHTED {
+    if opts.specular == SpecularModel::CookTorrance as u32
+        && opts.flags & ShadeOptions::MULTISCATTER != 0
+        && opts.diffuse != DiffuseModel::FresnelWeighted as u32
+    {
         let (single, multiple) = multiple_scattering(f, f0, s.brdf);
         let kd = (Vec3::ONE - single - multiple) * no_metal;
         return (kd * m.base_color * s.irradiance + single * s.prefiltered + multiple * s.irradiance) * m.occlusion;
     }
-    let specular = if opts.specular == specular_model::COOK_TORRANCE {
+    let specular = if opts.specular == SpecularModel::CookTorrance as u32 {
         s.prefiltered * (f * s.brdf.x + Vec3::splat(s.brdf.y))
-    } else if opts.specular == specular_model::NONE {
+    } else if opts.specular == SpecularModel::None as u32 {
         Vec3::ZERO
     } else {
         s.prefiltered * f

@@ -11,10 +11,11 @@ use crate::math;
 use spirv_std::glam::Vec3;
 
 /// Which tone curve to apply.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[derive(Copy, Clone, Debug, Default, PartialEq, Eq)]
 #[repr(u32)]
 pub enum Tonemapper {
     /// Narkowicz's ACES fit.
+    #[default]
     Aces = 0,
     /// Reinhard's `x/(1+x)`.
     Reinhard = 1,

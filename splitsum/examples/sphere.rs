@@ -193,10 +193,12 @@ fn main() -> splitsum::Result<()> {
     let env = splitsum::environment::embedded_default()?;
     let settings = Settings { size: 64, source_size: 128, mips: Settings::default_mips(64), ..Settings::default() };
     let material = Material { albedo: [0.5, 0.25, 0.1], f0: [0.04; 3], roughness: 0.3 };
+    let start = std::time::Instant::now();
     let picture = draw(&device, &queue, &env, &settings, compute, material, 256)?;
+    let seconds = start.elapsed().as_secs_f64();
     // Reinhard and sRGB-ish gamma for a look; the pixels themselves are linear radiance.
     let rgb: Vec<u8> = picture.pixels.iter().flat_map(|p| [p[0], p[1], p[2]].map(|c| ((c / (1.0 + c)).powf(1.0 / 2.2) * 255.0).round() as u8)).collect();
     splitsum::files::write_png(std::path::Path::new(&out), picture.size, picture.size, &rgb)?;
-    println!("baked on {compute:?} and drew {out}");
+    println!("baked on {compute:?} and drew {out} in {seconds:.2} s (pipelines, bake, draw and the picture's readback)");
     Ok(())
 }

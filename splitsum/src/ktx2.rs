@@ -36,16 +36,7 @@ pub enum Format {
     Rgba32f,
 }
 
-impl splitsum_shaders::choice::Choice for Format {
-    const ALL: &'static [Self] = &[Self::Auto, Self::Rgba16f, Self::Rgba32f];
-    fn name(self) -> &'static str {
-        match self {
-            Self::Auto => "auto",
-            Self::Rgba16f => "rgba16f",
-            Self::Rgba32f => "rgba32f",
-        }
-    }
-}
+splitsum_shaders::choice!(Format: Auto => "auto", Rgba16f => "rgba16f", Rgba32f => "rgba32f");
 
 /// What writing a cube did to its values.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]

@@ -19,15 +19,7 @@ pub enum TableMethod {
     Sampled,
 }
 
-impl Choice for TableMethod {
-    const ALL: &'static [Self] = &[Self::Quadrature, Self::Sampled];
-    fn name(self) -> &'static str {
-        match self {
-            Self::Quadrature => "quadrature",
-            Self::Sampled => "sampled",
-        }
-    }
-}
+splitsum_shaders::choice!(TableMethod: Quadrature => "quadrature", Sampled => "sampled");
 
 impl TableMethod {
     /// The masking term a table of this method has unless one is asked for: the exact
@@ -136,6 +128,9 @@ impl Default for Settings {
 /// Largest cube face accepted.
 pub const MAX_SIZE: u32 = 4096;
 
+/// Largest BRDF table accepted (a 4096² table is 128 MiB; beyond that nothing gains).
+pub const MAX_LUT_SIZE: u32 = 4096;
+
 impl Settings {
     /// Checks every value; an error names the field (`Error::Setting`).
     pub fn validate(&self) -> Result<()> {
@@ -166,8 +161,8 @@ impl Settings {
         if !(self.supersample_density > 0.0 && self.supersample_density <= 16.0) {
             return Err(Error::setting("supersample_density", format!("must be in (0, 16], not {}", self.supersample_density)));
         }
-        if self.lut_size == 0 || self.lut_size > crate::backend::MAX_LUT_SIZE {
-            return Err(Error::setting("lut_size", format!("must be from 1 to {}, not {}", crate::backend::MAX_LUT_SIZE, self.lut_size)));
+        if self.lut_size == 0 || self.lut_size > MAX_LUT_SIZE {
+            return Err(Error::setting("lut_size", format!("must be from 1 to {}, not {}", MAX_LUT_SIZE, self.lut_size)));
         }
         if self.lut_samples == 0 {
             return Err(Error::setting("lut_samples", "must be at least 1, not 0"));
@@ -176,6 +171,14 @@ impl Settings {
             return Err(Error::setting("lut_masking", "correlated needs the quadrature table method (the sampled table is Smith–Schlick only)"));
         }
         Ok(())
+    }
+
+    /// The defaults for an interactive display of an environment whose own face size is
+    /// `native` (`Environment::native_face_size`): a 128² specular cube from 256 samples
+    /// per texel, a 128² table, and the source cube as sharp as the environment.
+    pub fn display(native: u32) -> Self {
+        let size = 128;
+        Self { size, source_size: native.max(size), mips: Self::default_mips(size), samples: 256, lut_size: 128, lut_samples: 512, ..Self::default() }
     }
 
     /// The specular mip count for mip-0 faces of `size`: down to 8² faces, and at least two

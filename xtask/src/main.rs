@@ -46,6 +46,9 @@ fn run(check: bool) -> Result<bool, Error> {
     let mut builder = SpirvBuilder::new(root.join("shaders"), "spirv-unknown-vulkan1.1");
     builder.shader_panic_strategy = ShaderPanicStrategy::SilentExit;
     builder.release = true;
+    // The workspace pins stable; the shader crate must build with the nightly this xtask
+    // runs on (xtask/rust-toolchain.toml), so say so explicitly to the nested cargo.
+    builder.toolchain_overwrite = std::env::var("RUSTUP_TOOLCHAIN").ok();
     let result = builder.build()?;
     let spv = std::fs::read(result.module.unwrap_single())?;
     let words: Vec<u32> = spv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();

@@ -14,18 +14,17 @@ pub(super) fn default_run() -> anyhow::Result<()> {
             Backend::Cpu
         }
     };
-    let display = DisplayBakeArgs { size: 128, samples: 256, sanitize: false };
     let start = Instant::now();
-    let baked = bake::bake_for_display(&backend, &env, &display.settings(&env))?;
+    let baked = bake::bake_for_display(&backend, &env, &Settings::display(env.native_face_size()))?;
     println!("baked {name} on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
     let look = LookArgs {
-        diffuse: DiffuseArg::Lambert,
-        specular: SpecularArg::CookTorrance,
-        fresnel: FresnelArg::Schlick,
+        diffuse: DiffuseModel::default(),
+        specular: SpecularModel::default(),
+        fresnel: FresnelForm::default(),
         no_ibl: false,
         no_lights: false,
         exposure: 0.0,
-        tonemapper: TonemapArg::Aces,
+        tonemapper: Tonemapper::default(),
         sky_blur: 0.0,
         yaw: 0.0,
         pitch: 0.0,

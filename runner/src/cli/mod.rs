@@ -13,7 +13,6 @@ mod view;
 use crate::environment;
 use crate::files;
 use crate::ktx2::Format;
-use crate::scene::{DiffuseArg, FresnelArg, SpecularArg, TonemapArg};
 use crate::settings::{Products, Settings, TableMethod};
 use crate::{Backend, BackendKind};
 use anyhow::Context;
@@ -21,6 +20,8 @@ use clap::{Args, Parser, Subcommand};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_shaders::shade::{DiffuseModel, FresnelForm, SpecularModel};
+use splitsum_shaders::tonemap::Tonemapper;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -105,14 +106,14 @@ impl SceneArgs {
 #[derive(Args, Clone)]
 pub struct LookArgs {
     /// Diffuse model.
-    #[arg(long, value_parser = choice::<DiffuseArg>(), default_value = DiffuseArg::default().name())]
-    pub diffuse: DiffuseArg,
+    #[arg(long, value_parser = choice::<DiffuseModel>(), default_value = DiffuseModel::default().name())]
+    pub diffuse: DiffuseModel,
     /// Specular model.
-    #[arg(long, value_parser = choice::<SpecularArg>(), default_value = SpecularArg::default().name())]
-    pub specular: SpecularArg,
+    #[arg(long, value_parser = choice::<SpecularModel>(), default_value = SpecularModel::default().name())]
+    pub specular: SpecularModel,
     /// Fresnel form.
-    #[arg(long, value_parser = choice::<FresnelArg>(), default_value = FresnelArg::default().name())]
-    pub fresnel: FresnelArg,
+    #[arg(long, value_parser = choice::<FresnelForm>(), default_value = FresnelForm::default().name())]
+    pub fresnel: FresnelForm,
     /// Turn image-based lighting off.
     #[arg(long)]
     pub no_ibl: bool,
@@ -123,8 +124,8 @@ pub struct LookArgs {
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
     /// Tone curve.
-    #[arg(long, value_parser = choice::<TonemapArg>(), default_value = TonemapArg::default().name())]
-    pub tonemapper: TonemapArg,
+    #[arg(long, value_parser = choice::<Tonemapper>(), default_value = Tonemapper::default().name())]
+    pub tonemapper: Tonemapper,
     /// Blur of the sky behind the scene, in specular mips (0 = sharp).
     #[arg(long, default_value_t = 0.0)]
     pub sky_blur: f32,
@@ -159,7 +160,7 @@ impl LookArgs {
             yaw: self.yaw.to_radians(),
             pitch: self.pitch.to_radians(),
             exposure: auto_exposure * 2f32.powf(self.exposure),
-            tonemapper: self.tonemapper.curve(),
+            tonemapper: self.tonemapper,
             sky_blur: self.sky_blur,
             options: ShadeOptions { diffuse: self.diffuse.code(), specular: self.specular.code(), fresnel: self.fresnel.code(), flags },
             ..Default::default()
@@ -187,10 +188,10 @@ impl LookArgs {
 #[derive(Args, Clone)]
 pub struct DisplayBakeArgs {
     /// Face size of the specular cube.
-    #[arg(long, default_value_t = 128)]
+    #[arg(long, default_value_t = DISPLAY.size)]
     pub size: u32,
     /// GGX samples per specular texel.
-    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 256)]
+    #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = DISPLAY.samples)]
     pub samples: u32,
     /// Replace NaN/inf texels instead of refusing the environment.
     #[arg(long)]
@@ -201,9 +202,7 @@ impl DisplayBakeArgs {
     /// Bake settings for the display of `env`: the source cube as sharp as the environment
     /// (a quarter of an equirect's width, up to 1024), the rest from the flags.
     pub fn settings(&self, env: &environment::Environment) -> Settings {
-        let mips = Settings::default_mips(self.size);
-        let native = env.native_face_size();
-        Settings { size: self.size, source_size: native.max(self.size), mips, samples: self.samples, lut_size: 128, lut_samples: 512, ..Settings::default() }
+        Settings { size: self.size, mips: Settings::default_mips(self.size), samples: self.samples, ..Settings::display(env.native_face_size()) }
     }
 }
 
@@ -300,6 +299,9 @@ impl QualityArgs {
 
 /// The one set of defaults, `splitsum::Settings::default()`, as the flags show them.
 static DEFAULT: std::sync::LazyLock<Settings> = std::sync::LazyLock::new(Settings::default);
+
+/// The display's quicker defaults, `splitsum::Settings::display`, as the flags show them.
+static DISPLAY: std::sync::LazyLock<Settings> = std::sync::LazyLock::new(|| Settings::display(0));
 
 /// Clap's parser for a [`Choice`]: its names, listed in the help.
 pub(crate) fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {

@@ -1,7 +1,7 @@
 //! The CPU backend: the same `splitsum_shaders` functions the kernels call, run natively
 //! over every texel with rayon, with a progress bar on work that takes a while.
 
-use super::{Kernels, Prefilter, chunks};
+use super::kernels::{Kernels, Prefilter, chunks};
 use crate::error::Result;
 use crate::progress::bar as progress;
 use crate::texture::{Equirect, Sh9};

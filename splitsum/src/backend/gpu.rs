@@ -6,7 +6,8 @@
 //! that the time of a bake excludes it. Dispatches are recorded into one command encoder
 //! per product and submitted together.
 
-use super::{Kernels, Prefilter, chunks, cpu::Cpu};
+use super::cpu::Cpu;
+use super::kernels::{Kernels, Prefilter, chunks};
 use crate::error::{Error, Result};
 use crate::texture::{Equirect, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;

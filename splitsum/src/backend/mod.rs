@@ -11,78 +11,19 @@
 
 pub mod cpu;
 pub mod gpu;
+pub mod kernels;
 
 use crate::error::{Error, Result};
+use crate::settings::MAX_LUT_SIZE;
 use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::kernels::ProbeParams;
-use splitsum_shaders::math::CHUNK;
 
 pub use cpu::Cpu;
 pub use gpu::Gpu;
-
-/// The chunks `(start, count)` a sum of `n` terms is split into (see `math::CHUNK`).
-pub fn chunks(n: u32) -> impl Iterator<Item = (u32, u32)> {
-    let n = n.max(1);
-    (0..n.div_ceil(CHUNK)).map(move |k| (k * CHUNK, CHUNK.min(n - k * CHUNK)))
-}
-
-/// Largest BRDF table accepted (a 4096² table is 128 MiB; beyond that nothing gains).
-pub const MAX_LUT_SIZE: u32 = 4096;
-
-/// What a prefilter computes: level `m` of `layout` filtered for `roughness[m]` from
-/// `samples[m]` GGX samples, or summed exactly over source level `exact[m]` unless that is
-/// `prefilter::SAMPLED`; only `levels` are baked (the others stay zero: a plan leaves out
-/// what nothing reads).
-#[derive(Clone, Debug)]
-pub struct Prefilter<'a> {
-    /// Layout of the specular cube.
-    pub layout: CubeLayout,
-    /// Roughness of each level.
-    pub roughness: &'a [f32],
-    /// The levels baked.
-    pub levels: &'a [u32],
-    /// GGX samples of each level.
-    pub samples: &'a [u32],
-    /// Source level summed exactly for each level, or `prefilter::SAMPLED`.
-    pub exact: &'a [u32],
-    /// Added to the source level of each sample.
-    pub lod_bias: f32,
-}
-
-/// The operations a bake is made of, on one backend. Cubes are texels in `CubeLayout`
-/// order; tables are rows of `(A, B, 0, 0)`.
-pub trait Kernels {
-    /// Where this backend keeps texels.
-    type Texels;
-
-    /// Texels from host memory.
-    fn upload(&self, what: &str, texels: &[Vec4]) -> Result<Self::Texels>;
-    /// Texels back in host memory.
-    fn read(&self, texels: &Self::Texels) -> Result<Vec<Vec4>>;
-    /// `count` texels of `texels` from index `start`.
-    fn slice(&self, texels: &Self::Texels, start: u32, count: u32) -> Result<Self::Texels>;
-    /// Level 0 of a cube with faces of `size` resampled from `env` with `supersample`²
-    /// points per texel, and its full mip chain.
-    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Self::Texels>;
-    /// Fills levels 1.. of `cube` from its level 0.
-    fn build_mips(&self, cube: &mut Self::Texels, layout: CubeLayout) -> Result<()>;
-    /// The prefiltered specular cube of `job` from `src`.
-    fn prefilter(&self, src: &Self::Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Self::Texels>;
-    /// The irradiance cube (`E/π`) of faces of `size` from level `level` of `src`.
-    fn irradiance(&self, src: &Self::Texels, src_layout: CubeLayout, level: u32, size: u32) -> Result<Self::Texels>;
-    /// The per-row SH9 partial sums of level `level` of `src` (see `irradiance::sh9_row`).
-    fn sh9(&self, src: &Self::Texels, src_layout: CubeLayout, level: u32) -> Result<Sh9>;
-    /// The `size`² BRDF table from `samples` Hammersley points per texel.
-    fn brdf_lut(&self, size: u32, samples: u32) -> Result<Self::Texels>;
-    /// The `size`² BRDF table by deterministic quadrature with `masking`.
-    fn brdf_table(&self, size: u32, masking: Masking) -> Result<Self::Texels>;
-    /// `probes` evaluated with `params` over `cube` (see `kernels::probe_chunk`): raw
-    /// results, three `Vec4` per probe.
-    fn probe_raw(&self, params: ProbeParams, texels: &[Vec4], probes: &[Vec4], terms: u32) -> Result<Vec<Vec4>>;
-}
+pub use kernels::{Kernels, Prefilter, chunks};
 
 /// Which backend to bake with.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -93,15 +34,7 @@ pub enum BackendKind {
     Cpu,
 }
 
-impl splitsum_shaders::choice::Choice for BackendKind {
-    const ALL: &'static [Self] = &[Self::Gpu, Self::Cpu];
-    fn name(self) -> &'static str {
-        match self {
-            Self::Gpu => "gpu",
-            Self::Cpu => "cpu",
-        }
-    }
-}
+splitsum_shaders::choice!(BackendKind: Gpu => "gpu", Cpu => "cpu");
 
 /// An open backend.
 pub enum Backend {
@@ -247,8 +180,9 @@ impl Backend {
     /// Evaluates `probes` with `params` (see `kernels::probe_chunk`) over `cube`, if any:
     /// the BRDF table `(A, B)` in `xy`, a prefiltered or irradiance mean, or a cube lookup.
     pub fn probe(&self, params: ProbeParams, cube: Option<&Cube>, probes: &[Vec4]) -> Result<Vec<Vec4>> {
+        use splitsum_shaders::choice::Choice;
         use splitsum_shaders::cubemap::FACES;
-        use splitsum_shaders::kernels::probe_mode;
+        use splitsum_shaders::kernels::ProbeMode;
         use splitsum_shaders::{lut, prefilter};
         let texels: &[Vec4] = cube.map_or(&[], |c| &c.texels);
         let p = ProbeParams {
@@ -260,9 +194,10 @@ impl Backend {
         };
         let layout = CubeLayout::new(p.src_size, p.src_levels);
         // Terms of the sum each probe runs, in chunks.
-        let terms = match p.mode {
-            probe_mode::LUT | probe_mode::PREFILTER => p.samples.max(1),
-            probe_mode::IRRADIANCE => FACES * layout.level_size(p.src_level).pow(2),
+        let mode = ProbeMode::from_code(p.mode);
+        let terms = match mode {
+            ProbeMode::Lut | ProbeMode::Prefilter => p.samples.max(1),
+            ProbeMode::Irradiance => FACES * layout.level_size(p.src_level).pow(2),
             _ => 1,
         };
         let raw = with_kernels!(self, k => k.probe_raw(p, texels, probes, terms))?;
@@ -271,13 +206,13 @@ impl Backend {
             .chunks_exact(3)
             .zip(probes)
             .enumerate()
-            .map(|(i, (c, q))| match p.mode {
-                probe_mode::LUT => lut::resolve(c[0], p.samples).extend(0.0).extend(0.0),
+            .map(|(i, (c, q))| match mode {
+                ProbeMode::Lut => lut::resolve(c[0], p.samples).extend(0.0).extend(0.0),
                 // A mirror is no sum: the lookup itself.
-                probe_mode::PREFILTER if splitsum_shaders::math::saturate(q.w) <= 0.0 => {
+                ProbeMode::Prefilter if splitsum_shaders::math::saturate(q.w) <= 0.0 => {
                     prefilter::prefilter_dir(texels, layout, q.truncate(), 0.0, p.samples, p.lod_bias)
                 }
-                probe_mode::PREFILTER | probe_mode::IRRADIANCE => partial(i).resolve(),
+                ProbeMode::Prefilter | ProbeMode::Irradiance => partial(i).resolve(),
                 _ => c[0],
             })
             .collect())
