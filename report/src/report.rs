@@ -473,27 +473,17 @@ pub fn best_per_ms(rows: &[Measurement]) -> Vec<&Measurement> {
         .collect()
 }
 
-/// The fields of a line of `report.csv` (double-quoted fields may hold commas).
-pub fn csv_fields(line: &str) -> Vec<String> {
-    let mut out = vec![String::new()];
-    let mut quoted = false;
-    for c in line.chars() {
-        match c {
-            '"' => quoted = !quoted,
-            ',' if !quoted => out.push(String::new()),
-            _ => out.last_mut().expect("one field").push(c),
-        }
-    }
-    out
-}
-
 fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement]) -> Result<()> {
-    // CSV.
-    let mut csv = String::from("product,backend,setting,time_ms,mean_error,max_error,metric\n");
-    for r in rows {
-        let _ = writeln!(csv, "\"{}\",\"{}\",\"{}\",{:.4},{:.6e},{:.6e},{}", r.product, r.backend, r.setting, r.time_ms, r.mean_error, r.max_error, r.metric);
-    }
-    files::write_atomic(&dir.join("report.csv"), |w| std::io::Write::write_all(w, csv.as_bytes()))?;
+    // CSV (the csv crate quotes what needs quoting; `cost::Calibration` reads it back).
+    files::write_atomic(&dir.join("report.csv"), |w| {
+        let mut csv = csv::Writer::from_writer(w);
+        csv.write_record(["product", "backend", "setting", "time_ms", "mean_error", "max_error", "metric"])?;
+        for r in rows {
+            let (t, mean, max) = (format!("{:.4}", r.time_ms), format!("{:.6e}", r.mean_error), format!("{:.6e}", r.max_error));
+            csv.write_record([r.product.as_str(), &r.backend, &r.setting, &t, &mean, &max, r.metric])?;
+        }
+        csv.flush()
+    })?;
 
     // Markdown.
     let mut md = String::new();
