@@ -9,16 +9,30 @@ struct Xvfb(Child);
 
 impl Drop for Xvfb {
     fn drop(&mut self) {
-        let _ = self.0.kill();
+        // SIGTERM, so that Xvfb removes its socket and lock file (SIGKILL leaves them).
+        // SAFETY: signalling our own child.
+        unsafe { libc::kill(self.0.id() as i32, libc::SIGTERM) };
         let _ = self.0.wait();
+    }
+}
+
+/// Whether display `n` is taken: its lock file names a live process. (A killed server
+/// leaves a stale lock and socket behind; Xvfb replaces them.)
+fn taken(n: u32) -> bool {
+    match std::fs::read_to_string(format!("/tmp/.X{n}-lock")) {
+        Ok(pid) => pid.trim().parse::<u32>().is_ok_and(|pid| std::path::Path::new(&format!("/proc/{pid}")).exists()),
+        Err(_) => false,
     }
 }
 
 fn start_xvfb() -> (Xvfb, String) {
     for n in 90..120 {
-        if std::path::Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() || std::path::Path::new(&format!("/tmp/.X{n}-lock")).exists() {
+        if taken(n) {
             continue;
         }
+        // A dead server's leftovers: remove them, so that the socket below is the new one's.
+        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{n}"));
+        let _ = std::fs::remove_file(format!("/tmp/.X{n}-lock"));
         let child = Command::new("Xvfb")
             .args([format!(":{n}").as_str(), "-screen", "0", "1024x640x24", "-nolisten", "tcp"])
             .stdout(std::process::Stdio::null())

@@ -240,10 +240,10 @@ fn arc_piece(masking: Masking, nv: f32, sv: f32, a2: f32, alpha: f32, ta: f32, t
 /// each part; the kinks are at the part boundaries, where `φₘ` has square-root ends.
 ///
 /// **Estimator.**
-/// - `θ ∈ [0, θ₁]`: [`FULL_CIRCLE_PIECES`] equal pieces in θ, each with the 10-point
+/// - `θ ∈ [0, θ₁]`: `FULL_CIRCLE_PIECES` equal pieces in θ, each with the 10-point
 ///   Gauss–Legendre rule in `u` (which flattens the GGX peak; `1 − u` is carried in closed
 ///   form, so tiny `α` loses nothing), times the midpoint rule with
-///   [`FULL_CIRCLE_AZIMUTHS`] points in `φ ∈ [0, π]`.
+///   `FULL_CIRCLE_AZIMUTHS` points in `φ ∈ [0, π]`.
 /// - `θ ∈ [θ₁, θ₂]`: split at `θₘ = (θ₁ + θ₂)/2`; below it, pieces in geometric
 ///   progression of θ (the arc opens on the scale of θ₁ itself, which is tiny at grazing
 ///   `n·v`); above it, pieces in geometric progression of `θ₂ − θ` down to `½n·v` (near

@@ -123,7 +123,7 @@ impl Cache {
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
-                eprintln!("waiting for another run that bakes the same scene (cache lock {})", path.display());
+                crate::progress::note(&format!("waiting for another run that bakes the same scene (cache lock {})", path.display()));
                 file.lock().map_err(|e| Error::file(&path, format!("cannot lock: {e}")))?;
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(Error::file(&path, format!("cannot lock: {e}"))),

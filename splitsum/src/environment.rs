@@ -216,7 +216,7 @@ fn buffered(path: &Path) -> Result<std::io::BufReader<std::fs::File>> {
 }
 
 /// Reads an `.hdr` or `.exr` image as RGBA f32 (alpha 1), row 0 at the top, reduced by
-/// `factor` as an equirect ([`Reducer`]) and cleaned ([`clean`]'s rules).
+/// `factor` as an equirect (`Reducer`) and cleaned ([`clean`]'s rules).
 pub fn read_reduced(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
     match kind(path)? {
         Kind::Exr => read_exr(path, buffered(path)?, sanitize, factor),

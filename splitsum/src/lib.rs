@@ -18,12 +18,12 @@
 //!
 //! The math lives once, in `splitsum-shaders` (no_std): rust-gpu compiles it to the SPIR-V
 //! module committed in `splitsum-spirv`, and the same functions compile natively for the
-//! CPU backend. Both backends implement [`backend::Kernels`]; [`bake`] is the one bake
+//! CPU backend. Both backends implement [`backend::Kernels`]; [`bake`](mod@bake) is the one bake
 //! sequence over them; [`textures`] puts the products into the caller's textures.
 //!
 //! Modules, in the order data flows: [`environment`] (reading HDR files), [`settings`]
 //! (what to bake; one set of defaults, one validation), [`backend`] (CPU and GPU),
-//! [`bake`], [`textures`] (the wgpu API), [`output`] and [`ktx2`] (files), [`cache`]
+//! [`bake`](mod@bake), [`textures`] (the wgpu API), [`output`] and [`ktx2`] (files), [`cache`]
 //! (baked products by content), [`cost`] (estimates before a bake runs).
 
 #![warn(missing_docs)]

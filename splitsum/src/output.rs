@@ -183,12 +183,12 @@ pub fn write(dir: &Path, baked: &Baked, settings: &Settings, manifest_base: Mani
 
 fn report_clamp(name: &str, w: &ktx2::Written) {
     if w.clamped > 0 {
-        eprintln!(
+        crate::progress::note(&format!(
             "warning: {name}: {} values above the half-float maximum 65504 (largest {:.4e}) were clamped to 65504; the rgba32f format keeps them",
             w.clamped, w.max_value
-        );
+        ));
     } else if w.vk_format == ktx2::VK_FORMAT_R32G32B32A32_SFLOAT && w.max_value > ktx2::HALF_MAX {
-        eprintln!("note: {name}: values reach {:.4e}, beyond half floats: written as RGBA32F", w.max_value);
+        crate::progress::note(&format!("note: {name}: values reach {:.4e}, beyond half floats: written as RGBA32F", w.max_value));
     }
 }
 

@@ -2,20 +2,47 @@
 //! planner's estimate (`plan::step_seconds`), and the CPU backend's long loops a bar under
 //! it; all are drawn by one `indicatif::MultiProgress`. Where stderr is not a terminal
 //! (CI logs, pipes), bars are hidden and each step prints one line as it starts instead.
+//!
+//! A library stays quiet in its caller's terminal: nothing is shown until [`show`] turns it
+//! on (the command line does).
 
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::LazyLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 static MULTI: LazyLock<MultiProgress> = LazyLock::new(MultiProgress::new);
+static SHOWN: AtomicBool = AtomicBool::new(false);
+
+/// Shows progress on stderr from now on (`false`: hides it again).
+pub fn show(on: bool) {
+    SHOWN.store(on, Ordering::Relaxed);
+}
+
+fn shown() -> bool {
+    SHOWN.load(Ordering::Relaxed)
+}
 
 fn interactive() -> bool {
     std::io::stderr().is_terminal()
 }
 
+/// Says `message` (a note or a warning) on stderr where progress is shown, and through
+/// `log::warn!` otherwise, so that an application's logger gets it.
+pub fn note(message: &str) {
+    if shown() {
+        eprintln!("{message}");
+    } else {
+        log::warn!("{message}");
+    }
+}
+
 /// A bar of `len` units named `what`.
 pub fn bar(what: &str, len: u64) -> ProgressBar {
+    if !shown() {
+        return ProgressBar::hidden();
+    }
     let bar = MULTI.add(ProgressBar::new(len));
     bar.set_style(
         ProgressStyle::with_template("{prefix:>14} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})").expect("valid template").progress_chars("=> "),
@@ -33,6 +60,9 @@ pub fn step(what: &str, estimate: Option<f64>) -> Step {
         Some(s) if s >= 0.05 => format!(" (estimate {})", seconds(s)),
         _ => String::new(),
     };
+    if !shown() {
+        return Step(ProgressBar::hidden());
+    }
     if !interactive() {
         eprintln!("{what}…{est}");
         return Step(ProgressBar::hidden());

@@ -344,12 +344,12 @@ impl Gpu {
         let max = self.max_binding();
         match buffers.iter().copied().max() {
             Some(need) if need > max => {
-                eprintln!(
+                crate::progress::note(&format!(
                     "note: {step} needs a {:.0} MiB buffer, more than {} binds ({:.0} MiB): running this step on the CPU",
                     need as f64 / 1048576.0,
                     self.info.name,
                     max as f64 / 1048576.0
-                );
+                ));
                 false
             }
             _ => true,
