@@ -60,13 +60,14 @@ pub struct Baked {
     pub timings: Vec<Timing>,
 }
 
-/// Runs step `product`, estimated at `estimates` (see [`step_estimates`]), with its
-/// progress shown, and records its wall time.
-fn timed<T>(timings: &mut Vec<Timing>, product: &'static str, estimates: &[f64; 4], f: impl FnOnce() -> Result<T>) -> Result<T> {
+/// Runs step `product` on `k`, estimated at `estimates` (see [`step_estimates`]), with its
+/// progress shown, and records its wall time (until the backend has finished it).
+fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, product: &'static str, estimates: &[f64; 4], f: impl FnOnce() -> Result<T>) -> Result<T> {
     let estimate = STEPS.iter().position(|s| *s == product).map(|k| estimates[k]);
     let _step = crate::progress::step(product, estimate);
     let start = Instant::now();
     let r = f()?;
+    k.finish()?;
     timings.push(Timing { product, seconds: start.elapsed().as_secs_f64() });
     Ok(r)
 }
@@ -140,24 +141,24 @@ pub fn products<K: Kernels>(
         let (roughness, samples) = (s.roughness(), s.samples_per_mip());
         let exact = exact_levels(&roughness, &samples, s.exact_sums, source_layout);
         let job = Prefilter { layout: s.specular_layout(), roughness: &roughness, levels, samples: &samples, exact: &exact, lod_bias: s.lod_bias };
-        Some(timed(&mut timings, "specular", estimates, || k.prefilter(&source, source_layout, &job))?)
+        Some(timed(k, &mut timings, "specular", estimates, || k.prefilter(&source, source_layout, &job))?)
     } else {
         None
     };
     let irradiance = if products.irradiance {
         let level = level_of_size(source_layout, s.irradiance_source);
-        Some(timed(&mut timings, "irradiance", estimates, || k.irradiance(&source, source_layout, level, s.irradiance_size))?)
+        Some(timed(k, &mut timings, "irradiance", estimates, || k.irradiance(&source, source_layout, level, s.irradiance_size))?)
     } else {
         None
     };
     let sh9 = if products.sh9 {
         let level = level_of_size(source_layout, s.sh_source);
-        Some(timed(&mut timings, "sh9", estimates, || k.sh9(&source, source_layout, level))?)
+        Some(timed(k, &mut timings, "sh9", estimates, || k.sh9(&source, source_layout, level))?)
     } else {
         None
     };
     let lut = if products.lut {
-        Some(timed(&mut timings, "brdf lut", estimates, || match s.lut_method {
+        Some(timed(k, &mut timings, "brdf lut", estimates, || match s.lut_method {
             TableMethod::Quadrature => k.brdf_table(s.lut_size, s.lut_masking),
             TableMethod::Sampled => k.brdf_lut(s.lut_size, s.lut_samples),
         })?)
@@ -176,7 +177,7 @@ pub fn make<K: Kernels>(k: &K, gpu: bool, env: &Environment, settings: &Settings
     }
     let est = step_estimates(gpu, env, settings, products, levels);
     let mut timings = Vec::new();
-    let (source, layout) = timed(&mut timings, "source cube", &est, || source_cube(k, env, settings))?;
+    let (source, layout) = timed(k, &mut timings, "source cube", &est, || source_cube(k, env, settings))?;
     self::products(k, source, layout, settings, products, levels, &est, timings)
 }
 

@@ -120,6 +120,7 @@ impl Baker {
                         let mut timings = Vec::new();
                         let start = std::time::Instant::now();
                         let (src, layout) = texture_source_cube(g, t, settings)?;
+                        g.finish()?;
                         timings.push(Timing { product: "source cube", seconds: start.elapsed().as_secs_f64() });
                         bake::products(g, src, layout, settings, products, &levels, &est, timings)?
                     }

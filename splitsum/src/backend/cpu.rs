@@ -67,6 +67,10 @@ pub fn equirect_pyramid(env: &Equirect) -> Vec<Vec4> {
 impl Kernels for Cpu {
     type Texels = Vec<Vec4>;
 
+    fn finish(&self) -> Result<()> {
+        Ok(())
+    }
+
     fn upload(&self, _what: &str, texels: &[Vec4]) -> Result<Vec<Vec4>> {
         Ok(texels.to_vec())
     }

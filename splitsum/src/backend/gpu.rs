@@ -446,6 +446,11 @@ impl Gpu {
 impl Kernels for Gpu {
     type Texels = Texels;
 
+    fn finish(&self) -> Result<()> {
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
+        Ok(())
+    }
+
     fn upload(&self, what: &str, texels: &[Vec4]) -> Result<Texels> {
         Ok(Texels { buffer: self.upload_bytes(what, bytemuck::cast_slice(texels)), count: texels.len() as u32 })
     }

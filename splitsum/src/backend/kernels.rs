@@ -40,6 +40,9 @@ pub trait Kernels {
     /// Where this backend keeps texels.
     type Texels;
 
+    /// Waits until the work submitted so far has run (the GPU's queue; nothing on the CPU),
+    /// so that a step's wall time is its own.
+    fn finish(&self) -> Result<()>;
     /// Texels from host memory.
     fn upload(&self, what: &str, texels: &[Vec4]) -> Result<Self::Texels>;
     /// Texels back in host memory.
