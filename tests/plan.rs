@@ -208,7 +208,7 @@ fn reduced_and_full(s: &Scene, env: &Environment) -> (Plan, BakedEnvironment, Ba
 fn render(s: &Scene, env: &BakedEnvironment, backend: &Backend) -> Vec<Vec4> {
     let view = s.view(env.auto_exposure());
     let mut frame = view.frame(env.shape(), 96, 54, true);
-    frame.flags.x |= Frame::LINEAR;
+    frame.flags |= Frame::LINEAR;
     let model = s.model().unwrap();
     match (backend, &model) {
         (Backend::Cpu, Some(m)) => splitsum_display::raster::render(env, &frame, m),

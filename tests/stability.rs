@@ -196,7 +196,7 @@ fn extreme_environment_bakes_and_renders_finite() {
         l.radiance = Vec4::new(1e6, 1e6, 1e6, 0.0);
     }
     let mut frame = view.frame(scene.shape, 64, 40, true);
-    frame.flags.x |= splitsum_shaders::scene::Frame::LINEAR;
+    frame.flags |= splitsum_shaders::scene::Frame::LINEAR;
     let g = scene.render_offscreen(gpu, &frame, None).unwrap();
     assert!(g.iter().all(|p| p.is_finite()), "non-finite pixel on the GPU");
     let c = splitsum_display::render::render_cpu(&baked, &frame);

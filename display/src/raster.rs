@@ -76,7 +76,7 @@ struct Fragment {
 /// Renders the scene with `model` in it: the ray-cast spheres and sky, then every triangle
 /// depth-tested against them. Returns display values, row 0 at the top.
 pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4> {
-    let (w, h) = (frame.viewport.x as usize, frame.viewport.y as usize);
+    let (w, h) = (frame.width as usize, frame.height as usize);
     let mut colour = vec![Vec3::ZERO; w * h];
     let mut depth = vec![1.0f32; w * h];
     colour.par_chunks_mut(w).zip(depth.par_chunks_mut(w)).enumerate().for_each(|(y, (crow, drow))| {
@@ -93,7 +93,7 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
         let clip: Vec<Vec4> = prim.vertices.iter().map(|v| surface::clip(&frame.view_proj, Vec3::from(v.position))).collect();
         for (ti, tri) in prim.indices.chunks_exact(3).enumerate() {
             let c = [clip[tri[0] as usize], clip[tri[1] as usize], clip[tri[2] as usize]];
-            if c.iter().any(|v| v.w <= frame.depth_range.x) {
+            if c.iter().any(|v| v.w <= frame.near) {
                 continue; // behind the near plane: not drawn by either renderer in our scenes
             }
             let ndc = c.map(|v| v.truncate() / v.w);

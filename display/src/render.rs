@@ -8,7 +8,7 @@ use splitsum::backend::gpu::{Gpu, group_layout};
 use splitsum::bake::BakedEnvironment;
 use splitsum::error::{Error, Result};
 use splitsum_shaders::choice::Choice;
-use splitsum_shaders::glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
+use splitsum_shaders::glam::{Mat4, Vec2, Vec3, Vec4};
 use splitsum_shaders::scene::{self, Frame, Light, MAX_LIGHTS};
 use splitsum_shaders::shade::{DiffuseModel, EnvironmentShape, FresnelForm, ShadeOptions, SpecularModel};
 use splitsum_shaders::tonemap::Tonemapper;
@@ -152,19 +152,27 @@ impl ViewState {
             flags |= Frame::SPHERES;
         }
         Frame {
-            eye: eye.extend(1.0),
-            forward: forward.extend((0.5 * self.fov).tan()),
-            right: right.extend(width as f32 / height as f32),
+            eye: eye.extend(0.0),
+            forward: forward.extend(0.0),
+            right: right.extend(0.0),
             up: up.extend(0.0),
-            viewport: Vec4::new(width as f32, height as f32, self.exposure, self.sky_blur),
-            grid: UVec4::new(self.grid.0, self.grid.1, self.tonemapper as u32, self.lights.len().min(MAX_LIGHTS) as u32),
-            flags: UVec4::new(flags, 0, 0, 0),
+            width: width as f32,
+            height: height as f32,
+            exposure: self.exposure,
+            sky_blur: self.sky_blur,
+            rows: self.grid.0,
+            columns: self.grid.1,
+            tonemapper: self.tonemapper as u32,
+            light_count: self.lights.len().min(MAX_LIGHTS) as u32,
+            flags,
+            near: DEPTH_RANGE.0,
+            far: DEPTH_RANGE.1,
+            tan_half_fov: (0.5 * self.fov).tan(),
             options: self.options,
             shape,
             base_color: self.base_color.extend(1.0),
             lights,
             view_proj: perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * look_at(eye, forward, right, up),
-            depth_range: Vec4::new(DEPTH_RANGE.0, DEPTH_RANGE.1, 0.0, 0.0),
             grid_ranges: self.grid_ranges,
         }
     }
@@ -172,7 +180,7 @@ impl ViewState {
 
 /// The CPU reference renderer: `scene::pixel` at every pixel centre, row 0 at the top.
 pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
-    let (w, h) = (frame.viewport.x as u32, frame.viewport.y as u32);
+    let (w, h) = (frame.width as u32, frame.height as u32);
     let mut out = vec![Vec4::ZERO; (w * h) as usize];
     out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
         for (x, p) in row.iter_mut().enumerate() {
@@ -328,7 +336,7 @@ impl GpuScene {
 
     /// Renders `frame` offscreen into an RGBA32F texture and reads it back (row 0 at the top).
     pub fn render_offscreen(&self, gpu: &Gpu, frame: &Frame, model: Option<&GpuModel>) -> Result<Vec<Vec4>> {
-        let (w, h) = (frame.viewport.x as u32, frame.viewport.y as u32);
+        let (w, h) = (frame.width as u32, frame.height as u32);
         let format = wgpu::TextureFormat::Rgba32Float;
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("offscreen"),

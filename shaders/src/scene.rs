@@ -10,7 +10,7 @@ use crate::cubemap::{self, CubeLayout};
 use crate::shade::{self, EnvironmentShape, Material, ShadeOptions};
 use crate::{math, sampling, tonemap};
 use bytemuck::{Pod, Zeroable};
-use spirv_std::glam::{Mat4, UVec4, Vec2, Vec3, Vec4};
+use spirv_std::glam::{Mat4, Vec2, Vec3, Vec4};
 
 /// Most direct lights in a frame.
 pub const MAX_LIGHTS: usize = 4;
@@ -26,38 +26,56 @@ pub struct Light {
     pub radiance: Vec4,
 }
 
-/// Everything a frame needs besides the baked buffers (a uniform block: every field is a
-/// 16-byte vector so the layout is the same in Rust and in std140).
+/// Everything a frame needs besides the baked buffers: a uniform block whose layout is the
+/// same in Rust and in std140 without padding fields. Vectors are `Vec4` (std140 aligns a
+/// three-vector to 16 bytes, glam's host `Vec3` to 4), their `w` unused; scalars come in
+/// named groups of four.
 #[derive(Copy, Clone, Debug, PartialEq, Pod, Zeroable)]
 #[repr(C)]
 pub struct Frame {
-    /// Camera position (xyz).
+    /// Camera position (`xyz`).
     pub eye: Vec4,
-    /// Unit view direction (xyz); `w` = tan(vertical field of view / 2).
+    /// Unit view direction (`xyz`).
     pub forward: Vec4,
-    /// Unit right vector (xyz); `w` = width / height.
+    /// Unit right vector (`xyz`).
     pub right: Vec4,
-    /// Unit up vector (xyz).
+    /// Unit up vector (`xyz`).
     pub up: Vec4,
-    /// Width and height in pixels, exposure, sky blur (a specular mip, fractional).
-    pub viewport: Vec4,
-    /// Grid rows (metalness), grid columns (roughness), tonemapper code, light count.
-    pub grid: UVec4,
+    /// Width of the target in pixels.
+    pub width: f32,
+    /// Height of the target in pixels.
+    pub height: f32,
+    /// Exposure (a factor on radiance).
+    pub exposure: f32,
+    /// Blur of the sky: a specular mip, fractional.
+    pub sky_blur: f32,
+    /// Rows of the sphere grid (metalness).
+    pub rows: u32,
+    /// Columns of the sphere grid (roughness).
+    pub columns: u32,
+    /// The tone curve (a `Tonemapper` code).
+    pub tonemapper: u32,
+    /// Direct lights used, the first of `lights`.
+    pub light_count: u32,
     /// Bit 0: encode sRGB in the shader; bit 1: draw the sphere grid; bit 2: output linear
     /// radiance (no exposure, tone curve or encoding; for tests).
-    pub flags: UVec4,
+    pub flags: u32,
+    /// Near plane of the projection.
+    pub near: f32,
+    /// Far plane of the projection.
+    pub far: f32,
+    /// `tan` of half the vertical field of view.
+    pub tan_half_fov: f32,
     /// Shading models and lights.
     pub options: ShadeOptions,
     /// Shapes of the baked buffers.
     pub shape: EnvironmentShape,
     /// Base colour of the spheres (linear RGB).
     pub base_color: Vec4,
-    /// Direct lights; the first `grid.w` are used.
+    /// Direct lights; the first `light_count` are used.
     pub lights: [Light; MAX_LIGHTS],
     /// World to clip space of the camera (for rasterised meshes and the depth of ray hits).
     pub view_proj: Mat4,
-    /// Near and far planes of the projection.
-    pub depth_range: Vec4,
     /// The grid's metalness from the top row to the bottom (`x`, `y`) and roughness from
     /// the left column to the right (`z`, `w`).
     pub grid_ranges: Vec4,
@@ -80,10 +98,10 @@ pub const SPHERE_RADIUS: f32 = 0.42;
 /// The unit ray through pixel position `px` (pixel centres at half-integers, y down).
 #[inline]
 pub fn camera_ray(frame: &Frame, px: Vec2) -> Vec3 {
-    let tan = frame.forward.w;
-    let aspect = frame.right.w;
-    let x = (2.0 * px.x / frame.viewport.x - 1.0) * tan * aspect;
-    let y = (1.0 - 2.0 * px.y / frame.viewport.y) * tan;
+    let tan = frame.tan_half_fov;
+    let aspect = frame.width / frame.height;
+    let x = (2.0 * px.x / frame.width - 1.0) * tan * aspect;
+    let y = (1.0 - 2.0 * px.y / frame.height) * tan;
     let d = frame.forward.truncate() + frame.right.truncate() * x + frame.up.truncate() * y;
     sampling::normalize_or(d, frame.forward.truncate())
 }
@@ -97,8 +115,8 @@ pub fn sphere_centre(row: u32, col: u32, rows: u32, cols: u32) -> Vec3 {
 
 /// The nearest sphere hit along the ray: `(t, row, col)`, `t < 0` if none.
 pub fn hit_grid(frame: &Frame, origin: Vec3, dir: Vec3) -> (f32, u32, u32) {
-    let rows = frame.grid.x;
-    let cols = frame.grid.y;
+    let rows = frame.rows;
+    let cols = frame.columns;
     let mut best = -1.0f32;
     let mut best_row = 0;
     let mut best_col = 0;
@@ -139,8 +157,8 @@ pub fn grid_material(frame: &Frame, row: u32, col: u32) -> Material {
         base_color: frame.base_color.truncate(),
         // Clamped so that rounding never steps outside the declared range (a plan bakes
         // only the mips that range reads).
-        metallic: math::clamp(r.x + (r.y - r.x) * step(row, frame.grid.x), r.x, r.y),
-        roughness: math::clamp(r.z + (r.w - r.z) * step(col, frame.grid.y), r.z, r.w),
+        metallic: math::clamp(r.x + (r.y - r.x) * step(row, frame.rows), r.x, r.y),
+        roughness: math::clamp(r.z + (r.w - r.z) * step(col, frame.columns), r.z, r.w),
         occlusion: 1.0,
         emissive: Vec3::ZERO,
     }
@@ -162,7 +180,7 @@ pub fn shade_point(frame: &Frame, opts: ShadeOptions, specular: &[Vec4], irradia
         color += shade::ibl(opts, m, n, v, s);
     }
     if opts.flags & ShadeOptions::DIRECT != 0 {
-        let count = if (frame.grid.w as usize) < MAX_LIGHTS { frame.grid.w as usize } else { MAX_LIGHTS };
+        let count = if (frame.light_count as usize) < MAX_LIGHTS { frame.light_count as usize } else { MAX_LIGHTS };
         let mut i = 0;
         while i < count {
             let light = frame.lights[i];
@@ -185,14 +203,14 @@ pub fn shade_point(frame: &Frame, opts: ShadeOptions, specular: &[Vec4], irradia
 pub fn radiance_depth(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> (Vec3, f32) {
     let origin = frame.eye.truncate();
     let dir = camera_ray(frame, px);
-    if frame.flags.x & Frame::SPHERES != 0 {
+    if frame.flags & Frame::SPHERES != 0 {
         let (t, row, col) = hit_grid(frame, origin, dir);
         if t > 0.0 {
             let p = origin + dir * t;
-            let n = sampling::normalize_or(p - sphere_centre(row, col, frame.grid.x, frame.grid.y), -dir);
+            let n = sampling::normalize_or(p - sphere_centre(row, col, frame.rows, frame.columns), -dir);
             let m = grid_material(frame, row, col);
             let d = (p - origin).dot(frame.forward.truncate());
-            let depth = crate::surface::depth(d, frame.depth_range.x, frame.depth_range.y);
+            let depth = crate::surface::depth(d, frame.near, frame.far);
             return (shade_point(frame, frame.options, specular, irradiance, table, &m, p, n, -dir), depth);
         }
     }
@@ -208,7 +226,7 @@ pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &
 /// blur level (a fractional mip, i.e. a roughness).
 #[inline]
 pub fn sky(frame: &Frame, source: &[Vec4], specular: &[Vec4], dir: Vec3) -> Vec3 {
-    let blur = frame.viewport.w;
+    let blur = frame.sky_blur;
     if blur > 0.0 {
         let layout = CubeLayout::new(frame.shape.specular_size, frame.shape.specular_levels);
         cubemap::sample_lod(specular, layout, dir, blur).truncate()
@@ -222,14 +240,14 @@ pub fn sky(frame: &Frame, source: &[Vec4], specular: &[Vec4], dir: Vec3) -> Vec3
 /// sRGB encoding when the target does not encode itself.
 #[inline]
 pub fn to_display(frame: &Frame, c: Vec3) -> Vec4 {
-    if frame.flags.x & Frame::LINEAR != 0 {
+    if frame.flags & Frame::LINEAR != 0 {
         return c.extend(1.0);
     }
-    let curve = tonemap::Tonemapper::from_u32(frame.grid.z);
-    if frame.flags.x & Frame::ENCODE_SRGB != 0 {
-        tonemap::display(c, frame.viewport.z, curve).extend(1.0)
+    let curve = tonemap::Tonemapper::from_u32(frame.tonemapper);
+    if frame.flags & Frame::ENCODE_SRGB != 0 {
+        tonemap::display(c, frame.exposure, curve).extend(1.0)
     } else {
-        tonemap::tone(c, frame.viewport.z, curve).extend(1.0)
+        tonemap::tone(c, frame.exposure, curve).extend(1.0)
     }
 }
 

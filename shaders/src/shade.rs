@@ -244,8 +244,8 @@ pub struct EnvironmentShape {
     pub source_size: u32,
     /// Mips of the source cube.
     pub source_levels: u32,
-    /// Unused; keeps the block a multiple of 16 bytes.
-    pub pad: u32,
+    /// Mips of the irradiance cube (1: the display reads level 0).
+    pub irradiance_levels: u32,
 }
 
 /// The direction the prefiltered cube is read along for normal `n`, mirror direction
@@ -308,7 +308,7 @@ pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4
     let r = specular_direction(flags, n, sampling::reflect(v, n), roughness);
     IblSample {
         prefiltered: prefiltered(shape, specular, flags, r, roughness).truncate(),
-        irradiance: cubemap::sample_bilinear(irradiance, CubeLayout::new(shape.irradiance_size, 1), 0, n).truncate(),
+        irradiance: cubemap::sample_bilinear(irradiance, CubeLayout::new(shape.irradiance_size, shape.irradiance_levels), 0, n).truncate(),
         brdf: lut::sample(table, shape.lut_size, n_dot_v, roughness),
     }
 }

@@ -270,7 +270,7 @@ impl BakedEnvironment {
             lut_size: self.lut.size,
             source_size: self.source.layout.size,
             source_levels: 1,
-            pad: 0,
+            irradiance_levels: self.irradiance.layout.levels,
         }
     }
 }

@@ -165,7 +165,11 @@ pub const MANIFESTS: [&str; 3] = ["bake.json", "plan.json", "report.md"];
 /// while it swaps folders.
 static PENDING: std::sync::Mutex<Vec<(PathBuf, Vec<PathBuf>)>> = std::sync::Mutex::new(Vec::new());
 
-fn install_interrupt_cleanup() {
+/// Makes SIGINT, SIGTERM and SIGHUP remove every uncommitted staging folder (and the
+/// folders made for it) and exit with 130. A process-wide signal handler: the command line
+/// installs it; an application with its own handling leaves it out (its interrupted runs
+/// may then leave a hidden `.NAME.splitsum-PID` folder beside the output).
+pub fn remove_staging_on_interrupt() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // ctrlc runs this on its own thread, so it may take locks and touch files.
@@ -187,8 +191,8 @@ fn install_interrupt_cleanup() {
 /// it, and [`OutputDir::commit`] swaps the staging folder and the old folder in one
 /// `renameat2(RENAME_EXCHANGE)` (Linux; elsewhere two renames), then removes the old one. A
 /// reader sees the whole old set of files or the whole new set, never a mix; a failure
-/// or an interruption before the commit leaves the old folder as it was, no staging folder
-/// and no folder this run created.
+/// before the commit leaves the old folder as it was, no staging folder and no folder this
+/// run created, and so does an interruption once [`remove_staging_on_interrupt`] is on.
 pub struct OutputDir {
     target: PathBuf,
     staging: PathBuf,
@@ -238,7 +242,6 @@ impl OutputDir {
             }
         }
         created.reverse();
-        install_interrupt_cleanup();
         let staging = parent.join(format!(".{}.splitsum-{}", name.to_string_lossy(), std::process::id()));
         {
             let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());

@@ -413,6 +413,7 @@ where
 {
     use clap::{CommandFactory, FromArgMatches};
     crate::progress::show(true);
+    crate::files::remove_staging_on_interrupt();
     let matches = Cli::command().try_get_matches_from(args)?;
     let cli = Cli::from_arg_matches(&matches)?;
     // The flags written on the command line (not defaulted), as the user wrote them.
