@@ -89,11 +89,12 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()>
     write_rgb8(path, width, height, rgb, image::ImageFormat::Png)
 }
 
-/// The 8-bit format the name of `path` asks for (given as `flag`): PNG or JPEG.
-pub fn picture_format(path: &Path, flag: &str) -> Result<image::ImageFormat> {
+/// The 8-bit format the name of `path` asks for: PNG or JPEG. `called` is what the caller
+/// calls the path (a flag, a field), for the message.
+pub fn picture_format(path: &Path, called: &str) -> Result<image::ImageFormat> {
     match image::ImageFormat::from_path(path) {
         Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => Ok(f),
-        _ => Err(Error::Invalid(format!("{flag} {}: name a .png or .jpg file (the format follows the extension)", path.display()))),
+        _ => Err(Error::Invalid(format!("{called} {}: name a .png or .jpg file (the format follows the extension)", path.display()))),
     }
 }
 
@@ -201,13 +202,14 @@ pub struct OutputDir {
 }
 
 impl OutputDir {
-    /// Starts writing the folder `target` (given as `flag`, for messages). Refuses a path
+    /// Starts writing the folder `target`; `called` is what the caller calls it (a flag, a
+    /// field), for messages. Refuses a path
     /// that is a file, and a folder holding files that no splitsum run wrote (it would be
     /// replaced whole).
-    pub fn begin(target: &Path, flag: &str) -> Result<Self> {
+    pub fn begin(target: &Path, called: &str) -> Result<Self> {
         let shown = target.display();
         match std::fs::metadata(target) {
-            Ok(m) if !m.is_dir() => return Err(Error::Invalid(format!("{flag} {shown} is an existing file; give a folder (it is created if missing)"))),
+            Ok(m) if !m.is_dir() => return Err(Error::Invalid(format!("{called} {shown} is an existing file; give a folder (it is created if missing)"))),
             Ok(_) => {
                 let entries: Vec<String> = std::fs::read_dir(target)
                     .map_err(|e| Error::file(target, format!("cannot read the output folder: {e}")))?
@@ -218,7 +220,7 @@ impl OutputDir {
                     some.sort();
                     some.truncate(3);
                     return Err(Error::Invalid(format!(
-                        "{flag} {shown} holds files splitsum did not write ({}{}); the output folder is replaced as a whole, so give a new or empty folder",
+                        "{called} {shown} holds files splitsum did not write ({}{}); the output folder is replaced as a whole, so give a new or empty folder",
                         some.join(", "),
                         if entries.len() > 3 { ", …" } else { "" }
                     )));
@@ -226,10 +228,9 @@ impl OutputDir {
             }
             Err(_) => {}
         }
-        let name = target
-            .file_name()
-            .filter(|n| *n != "." && *n != "..")
-            .ok_or_else(|| Error::Invalid(format!("{flag} {shown} names no folder (the output folder is replaced as a whole; give one such as {flag} out)")))?;
+        let name = target.file_name().filter(|n| *n != "." && *n != "..").ok_or_else(|| {
+            Error::Invalid(format!("{called} {shown} names no folder (the output folder is replaced as a whole; give one such as {called} out)"))
+        })?;
         let parent = parent_dir(target);
         // The folders above the output that this run creates (removed again on failure).
         let mut created = Vec::new();
