@@ -404,22 +404,26 @@ impl Scene {
                 return bad(format!("[quality] max_error must be positive, not {e}"));
             }
         }
+        // The [quality] fields that are bake settings go through the one validation,
+        // `Settings::validate`, which names them as the scene does.
         let q = &self.quality;
-        for (field, v) in [("samples", q.samples), ("lut_samples", q.lut_samples)] {
-            if v == Some(0) {
-                return bad(format!("[quality] {field} must be at least 1, not 0"));
-            }
-        }
-        if let Some(v) = q.lut_size.filter(|v| !(1..=splitsum::settings::MAX_LUT_SIZE).contains(v)) {
-            return bad(format!("[quality] lut_size must be from 1 to {}, not {v}", splitsum::settings::MAX_LUT_SIZE));
-        }
-        for (field, v, max) in [("size", q.size, splitsum::settings::MAX_SIZE), ("irradiance_source", q.irradiance_source, 256)] {
-            if let Some(v) = v.filter(|v| !v.is_power_of_two() || *v > max) {
-                return bad(format!("[quality] {field} must be a power of two from 1 to {max}, not {v}"));
-            }
-        }
-        if let Some(b) = q.lod_bias.filter(|b| !(b.is_finite() && (-16.0..=16.0).contains(b))) {
-            return bad(format!("[quality] lod_bias must be within ±16, not {b}"));
+        let d = splitsum::Settings::default();
+        let size = q.size.unwrap_or(d.size);
+        let settings = splitsum::Settings {
+            size,
+            source_size: d.source_size.max(size),
+            mips: splitsum::Settings::default_mips(size),
+            samples: q.samples.unwrap_or(d.samples),
+            lut_samples: q.lut_samples.unwrap_or(d.lut_samples),
+            lut_size: q.lut_size.unwrap_or(d.lut_size),
+            irradiance_source: q.irradiance_source.unwrap_or(d.irradiance_source),
+            lod_bias: q.lod_bias.unwrap_or(d.lod_bias),
+            ..d
+        };
+        match settings.validate() {
+            Err(splitsum::Error::Setting { field, problem }) => return bad(format!("[quality] {field} {problem}")),
+            Err(e) => return Err(e),
+            Ok(()) => {}
         }
         Ok(())
     }
