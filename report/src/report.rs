@@ -219,7 +219,7 @@ fn directions(n: u32) -> Vec<Vec3> {
 /// Runs the report's sweeps of `env` on `backends`, writes the three files into `dir`, and
 /// returns the measurements.
 pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, dir: &Path) -> Result<Vec<Measurement>> {
-    std::fs::create_dir_all(dir).map_err(|e| splitsum::Error::file(dir, format!("cannot create the output folder: {e}")))?;
+    files::create_folder(dir)?;
     files::check_writable(&dir.join("report.md"))?;
     let settings = Settings { source_size: sweep.source_size, size: sweep.source_size, ..Settings::default() };
     let source = bake::host_source_cube(&Backend::Cpu, env, &settings)?;

@@ -51,9 +51,10 @@ fn temp_path(path: &Path) -> PathBuf {
 pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>) -> Result<()> {
     let tmp = temp_path(path);
     let result = (|| {
+        // Every change to a folder's entries happens under the interrupt lock: an interrupt
+        // that removes a staging folder holds it until the process exits, so nothing is
+        // created or renamed in it behind the removal (which would leave it behind).
         let file = {
-            // Under the interrupt lock: an interrupt that removed a staging folder holds
-            // it until the process exits, so no folder is created again behind it.
             let _interrupt = PENDING.lock().unwrap_or_else(|e| e.into_inner());
             std::fs::create_dir_all(parent_dir(path))?;
             File::create(&tmp)?
@@ -62,12 +63,21 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> std
         write(&mut w)?;
         w.flush()?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
+        let _interrupt = PENDING.lock().unwrap_or_else(|e| e.into_inner());
         std::fs::rename(&tmp, path)
     })();
     result.map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         Error::file(path, format!("could not write: {e}"))
     })
+}
+
+/// Creates the folder `dir` and its parents, under the interrupt lock (see
+/// [`remove_staging_on_interrupt`]): a folder about to be removed by an interrupt is not
+/// made again.
+pub fn create_folder(dir: &Path) -> Result<()> {
+    let _interrupt = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+    std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, format!("cannot create the output folder: {e}")))
 }
 
 /// Writes the BRDF table as a two-channel (R = scale, G = bias) 32-bit float OpenEXR.

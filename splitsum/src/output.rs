@@ -3,7 +3,7 @@
 
 use crate::bake::{Baked, Timing};
 use crate::environment::InputReport;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::files;
 use crate::ktx2;
 use crate::preview;
@@ -121,7 +121,7 @@ struct ShFile<'a> {
 /// `bake.json` last.
 pub fn write(dir: &Path, baked: &Baked, settings: &Settings, manifest_base: Manifest) -> Result<Manifest> {
     let _step = crate::progress::step("writing the files", None);
-    std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, format!("cannot create the output folder: {e}")))?;
+    files::create_folder(dir)?;
     let mut manifest = manifest_base;
     let mut files_out = Vec::new();
     let mut add = |name: &str, what: String, written: Option<ktx2::Written>| {
