@@ -154,3 +154,23 @@ fn draco_compressed_models_decode_to_their_geometry() {
         assert!(worst_pos < 1e-4 && worst_uv < 5e-4 && worst_nrm < 1e-4, "speed {speed}");
     }
 }
+
+/// The glTF crate unwraps an embedded image's MIME type while importing even a validated
+/// file (gltf 1.4.1, `image.rs`); a file without one is a clear error, not a panic. Found
+/// by `fuzz::gltf_models` in a fresh-clone CI run.
+#[test]
+fn an_embedded_image_without_a_mime_type_is_an_error_not_a_panic() {
+    let glb = support::model::sample_glb();
+    let json_len = u32::from_le_bytes(glb[12..16].try_into().unwrap()) as usize;
+    let mut json: serde_json::Value = serde_json::from_slice(&glb[20..20 + json_len]).unwrap();
+    let bin_start = 20 + json_len + 8;
+    let bin = &glb[bin_start..];
+    json["images"][0].as_object_mut().unwrap().remove("mimeType");
+    let dir = std::env::temp_dir().join(format!("splitsum-mime-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("no-mime.glb");
+    std::fs::write(&path, support::model::glb(&json, bin)).unwrap();
+    let e = splitsum_display::model::load(&path).err().expect("refused").to_string();
+    assert!(e.contains("no-mime.glb") && e.contains("malformed glTF"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -118,18 +118,26 @@ pub const PLACE_BESIDE_GRID: (Vec3, f32) = (Vec3::new(5.4, 0.0, 0.0), 3.2);
 /// Loads the default scene of a `.gltf` or `.glb` file.
 pub fn load(path: &Path) -> Result<Model> {
     check_extensions(path)?;
-    let validated = gltf::import(path);
+    // The glTF crate panics on some malformed files even while importing them validated
+    // (an embedded image without a MIME type: `image.rs`, an `unwrap`); so does reading an
+    // unvalidated document whose indices point past its arrays. Both become an error
+    // about the file.
+    let malformed = |_| Err(Error::file(path, "malformed glTF (an index points past its array, or a required field is missing)"));
+    let validated = match std::panic::catch_unwind(|| gltf::import(path)) {
+        Ok(v) => v,
+        Err(p) => return malformed(p),
+    };
     let (doc, buffers, images) = match validated {
         Ok(imported) => imported,
         // Draco primitives' accessors have no bufferView (their data is in the extension's),
         // which the validator reports as missing data: read such a file unvalidated.
-        Err(_) if uses_draco(path) => import_unvalidated(path)?,
+        Err(_) if uses_draco(path) => match std::panic::catch_unwind(|| import_unvalidated(path)) {
+            Ok(imported) => imported?,
+            Err(p) => return malformed(p),
+        },
         Err(e) => return Err(Error::file(path, format!("cannot load the glTF: {e}"))),
     };
-    // An unvalidated document may index past its arrays, and the glTF crate panics there:
-    // turn that into an error about the file.
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| from_document(path, doc, buffers, images)))
-        .unwrap_or_else(|_| Err(Error::file(path, "malformed glTF (an index points past its array)")))
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| from_document(path, doc, buffers, images))).unwrap_or_else(malformed)
 }
 
 /// The name of the Draco extension (Khronos, `KHR_draco_mesh_compression`).
