@@ -72,6 +72,19 @@ pub fn pack_radiance(a: f32, b: f32) -> u32 {
     f32_to_f16_bits(c(a)) | (f32_to_f16_bits(c(b)) << 16)
 }
 
+/// Texel `x` of the copied texture row starting at word `row` of `words`: four halves
+/// (two words) or four f32 (four words) per texel, RGBA.
+#[inline]
+pub fn copied_texel(words: &[u32], row: usize, x: usize, half: bool) -> Vec4 {
+    if half {
+        let (a, b) = (words[row + 2 * x], words[row + 2 * x + 1]);
+        Vec4::new(f16_bits_to_f32(a & 0xffff), f16_bits_to_f32(a >> 16), f16_bits_to_f32(b & 0xffff), f16_bits_to_f32(b >> 16))
+    } else {
+        let w = row + 4 * x;
+        Vec4::new(f32::from_bits(words[w]), f32::from_bits(words[w + 1]), f32::from_bits(words[w + 2]), f32::from_bits(words[w + 3]))
+    }
+}
+
 /// A texel read from a caller's texture, made what the bake takes: NaN and negative
 /// values become 0, values above `math::MAX_RADIANCE` (and +∞) become it.
 #[inline]

@@ -462,14 +462,7 @@ pub fn unpack_rows(
 ) {
     if id.x < p.width && id.y < p.rows {
         let row = (p.word_offset + id.y * p.row_words) as usize;
-        let v = if p.half == 1 {
-            let w = row + 2 * id.x as usize;
-            let (a, b) = (words[w], words[w + 1]);
-            Vec4::new(half::f16_bits_to_f32(a & 0xffff), half::f16_bits_to_f32(a >> 16), half::f16_bits_to_f32(b & 0xffff), half::f16_bits_to_f32(b >> 16))
-        } else {
-            let w = row + 4 * id.x as usize;
-            Vec4::new(f32::from_bits(words[w]), f32::from_bits(words[w + 1]), f32::from_bits(words[w + 2]), f32::from_bits(words[w + 3]))
-        };
+        let v = half::copied_texel(words, row, id.x as usize, p.half == 1);
         texels[(p.texel_offset + id.y * p.width + id.x) as usize] = half::clean_radiance(v);
     }
 }

@@ -108,20 +108,26 @@ pub fn source_cube<K: Kernels>(k: &K, env: &Environment, settings: &Settings) ->
             Ok((k.equirect_to_cube(e, size, n)?, layout))
         }
         Environment::Cube(c) => {
-            let f = c.layout.size;
-            if f < size {
-                return Err(Error::setting("source_size", format!("{size} is larger than the cube's {f}×{f} faces; upsampling adds nothing")));
-            }
-            let full_layout = CubeLayout::new(f, CubeLayout::full_chain(f));
+            let full_layout = CubeLayout::new(c.layout.size, CubeLayout::full_chain(c.layout.size));
             let mut texels = c.texels.clone();
             texels.resize(full_layout.texel_count() as usize, Default::default());
-            let mut full = k.upload("cube faces", &texels)?;
-            k.build_mips(&mut full, full_layout)?;
-            let first = level_of_size(full_layout, size);
-            let start = full_layout.level_offset(first);
-            Ok((k.slice(&full, start, full_layout.texel_count() - start)?, layout))
+            cube_source(k, k.upload("cube faces", &texels)?, c.layout.size, settings)
         }
     }
+}
+
+/// The source cube of `settings` from a cube whose faces are `face` wide: `full` holds its
+/// level 0 in a buffer of its full mip chain; the chain is filtered and the levels from
+/// `settings.source_size` down are kept.
+pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, settings: &Settings) -> Result<(K::Texels, CubeLayout)> {
+    let size = settings.source_size;
+    if face < size {
+        return Err(Error::setting("source_size", format!("{size} is larger than the cube's {face}×{face} faces; upsampling adds nothing")));
+    }
+    let full_layout = CubeLayout::new(face, CubeLayout::full_chain(face));
+    k.build_mips(&mut full, full_layout)?;
+    let start = full_layout.level_offset(level_of_size(full_layout, size));
+    Ok((k.slice(&full, start, full_layout.texel_count() - start)?, CubeLayout::new(size, CubeLayout::full_chain(size))))
 }
 
 /// Bakes `products` (and `levels` of the specular cube; the others stay zero) from a

@@ -21,7 +21,7 @@ use crate::settings::{Products, Settings};
 use crate::texture::{Cube, Equirect};
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_shaders::glam::Vec4;
-use splitsum_shaders::half::{clean_radiance, f16_bits_to_f32, pack_radiance};
+use splitsum_shaders::half::{clean_radiance, copied_texel, f16_bits_to_f32, pack_radiance};
 use splitsum_shaders::kernels::RowsParams;
 use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_spirv as spirv;
@@ -305,14 +305,8 @@ impl Baker {
         let mut texels = Vec::with_capacity((size.width * size.height * size.depth_or_array_layers) as usize);
         for r in 0..(size.height * size.depth_or_array_layers) as usize {
             for x in 0..size.width as usize {
-                let w = &words[r * row_words..];
-                let v = if half {
-                    let (a, b) = (w[2 * x], w[2 * x + 1]);
-                    Vec4::new(f16_bits_to_f32(a & 0xffff), f16_bits_to_f32(a >> 16), f16_bits_to_f32(b & 0xffff), f16_bits_to_f32(b >> 16))
-                } else {
-                    Vec4::new(f32::from_bits(w[4 * x]), f32::from_bits(w[4 * x + 1]), f32::from_bits(w[4 * x + 2]), f32::from_bits(w[4 * x + 3]))
-                };
-                texels.push(clean_radiance(v).truncate().extend(1.0));
+                let v = clean_radiance(copied_texel(words, r * row_words, x, half));
+                texels.push(v.truncate().extend(1.0));
             }
         }
         Ok(match shape {
@@ -362,25 +356,13 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) ->
         output: &texels.buffer,
         invocations: [size.width, rows, 1],
     }]);
-    let source_size = settings.source_size;
-    let layout = CubeLayout::new(source_size, CubeLayout::full_chain(source_size));
     match shape {
         Shape::Equirect => {
+            let source_size = settings.source_size;
             let n = splitsum_shaders::equirect::supersampling(source_size, size.width, settings.supersample_density);
-            Ok((g.pyramid_to_cube(&texels.buffer, size.width, size.height, source_size, n)?, layout))
+            Ok((g.pyramid_to_cube(&texels.buffer, size.width, size.height, source_size, n)?, CubeLayout::new(source_size, CubeLayout::full_chain(source_size))))
         }
-        Shape::Cube => {
-            let f = size.width;
-            if f < source_size {
-                return Err(Error::setting("source_size", format!("{source_size} is larger than the cube's {f}×{f} faces; upsampling adds nothing")));
-            }
-            let full = CubeLayout::new(f, CubeLayout::full_chain(f));
-            let mut texels = texels;
-            g.build_mips(&mut texels, full)?;
-            let first = crate::settings::level_of_size(full, source_size);
-            let start = full.level_offset(first);
-            Ok((g.slice(&texels, start, full.texel_count() - start)?, layout))
-        }
+        Shape::Cube => bake::cube_source(g, texels, size.width, settings),
     }
 }
 

@@ -14,7 +14,6 @@ pub mod gpu;
 pub mod kernels;
 
 use crate::error::{Error, Result};
-use crate::settings::MAX_LUT_SIZE;
 use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::CubeLayout;
@@ -61,14 +60,9 @@ macro_rules! with_kernels {
 }
 pub(crate) use with_kernels;
 
+/// The BRDF table's arguments through the one validation, `Settings::validate`.
 fn check_lut_args(size: u32, samples: u32) -> Result<()> {
-    if size == 0 || size > MAX_LUT_SIZE {
-        return Err(Error::setting("lut_size", format!("must be from 1 to {MAX_LUT_SIZE}, not {size}")));
-    }
-    if samples == 0 {
-        return Err(Error::setting("lut_samples", "must be at least 1, not 0"));
-    }
-    Ok(())
+    crate::settings::Settings { lut_size: size, lut_samples: samples, ..Default::default() }.validate()
 }
 
 impl Backend {
