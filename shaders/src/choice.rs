@@ -5,6 +5,7 @@
 //! it parses, prints and decodes these through [`Choice`].
 
 use crate::brdf::microfacet::Masking;
+use crate::equirect::Facing;
 use crate::prefilter::RoughnessMapping;
 use crate::shade::{DiffuseModel, FresnelForm, SpecularModel};
 use crate::tonemap::Tonemapper;
@@ -51,8 +52,9 @@ macro_rules! choice {
     };
 }
 
-choice!(RoughnessMapping: Linear => "linear", Quadratic => "quadratic", Geometric => "geometric");
+choice!(RoughnessMapping: Linear => "linear", Quadratic => "quadratic", Geometric => "geometric", Filament => "filament");
 choice!(Masking: SmithSchlick => "schlick", SmithCorrelated => "correlated");
+choice!(Facing: NegZ => "-z", PosX => "+x", PosZ => "+z", NegX => "-x");
 choice!(Tonemapper: Aces => "aces", Reinhard => "reinhard", Clamp => "clamp");
 choice!(DiffuseModel: Lambert => "lambert", OrenNayar => "oren-nayar", FresnelWeighted => "fresnel-weighted");
 choice!(SpecularModel: CookTorrance => "cook-torrance", Phong => "phong", BlinnPhong => "blinn-phong", None => "none");

@@ -23,6 +23,71 @@ use crate::cubemap;
 use crate::math;
 use spirv_std::glam::{Vec2, Vec3, Vec4};
 
+/// Which way the image centre faces in the cube: the equirect's orientation, a turn of
+/// the whole environment about `+Y` (up stays up, handedness is kept). Each engine's own
+/// baker fixes one (measured and cited in the README):
+///
+/// - `NegZ`, splitsum's ([`dir_to_uv`]): the centre looks down `−Z`;
+/// - `PosX`, the Khronos glTF-IBL-Sampler's (`filter.frag`, `dirToUV`
+///   `u = ½ + atan2(z, x)/2π` with its `direction.y = −direction.y`): the centre looks
+///   down `+X`; splitsum's `(x, y, z)` is its `(−z, y, x)`;
+/// - `PosZ`, Filament cmgen's (`CubemapUtils::equirectangularToCubemap`,
+///   `u = ½ + atan2(x, z)/2π`, then `mirrorCubemap`, `x → −x`, which cmgen applies by
+///   default): the centre looks down `+Z`; splitsum's `(x, y, z)` is its `(−x, y, −z)`.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Facing {
+    /// Centre at `−Z` (splitsum).
+    NegZ = 0,
+    /// Centre at `+X` (glTF-IBL-Sampler, so the glTF Sample Viewer and Bevy).
+    PosX = 1,
+    /// Centre at `+Z` (Filament's cmgen).
+    PosZ = 2,
+    /// Centre at `−X`.
+    NegX = 3,
+}
+
+impl Facing {
+    /// The facing encoded as `u32` in kernel parameters; unknown codes are `NegZ`.
+    #[inline]
+    pub fn from_u32(code: u32) -> Self {
+        if code == 1 {
+            Self::PosX
+        } else if code == 2 {
+            Self::PosZ
+        } else if code == 3 {
+            Self::NegX
+        } else {
+            Self::NegZ
+        }
+    }
+
+    /// The direction, in splitsum's image convention ([`dir_to_uv`]), that a cube with
+    /// this facing shows at cube direction `d`: the inverse turn about `+Y`.
+    #[inline]
+    pub fn image_direction(self, d: Vec3) -> Vec3 {
+        match self {
+            Self::NegZ => d,
+            // Cube (x, y, z) = (−z', y', x') of the image direction (x', y', z').
+            Self::PosX => Vec3::new(d.z, d.y, -d.x),
+            Self::PosZ => Vec3::new(-d.x, d.y, -d.z),
+            Self::NegX => Vec3::new(-d.z, d.y, d.x),
+        }
+    }
+
+    /// The cube direction at which a cube with this facing shows image direction `d`
+    /// (the inverse of [`Facing::image_direction`]).
+    #[inline]
+    pub fn cube_direction(self, d: Vec3) -> Vec3 {
+        match self {
+            Self::NegZ => d,
+            Self::PosX => Vec3::new(-d.z, d.y, d.x),
+            Self::PosZ => Vec3::new(-d.x, d.y, -d.z),
+            Self::NegX => Vec3::new(d.z, d.y, -d.x),
+        }
+    }
+}
+
 /// Equirect coordinates `(u, v)` ∈ [0, 1]² of direction `d` (need not be unit).
 #[inline]
 pub fn dir_to_uv(d: Vec3) -> Vec2 {
@@ -164,9 +229,10 @@ pub fn reduction_factor(width: u32, height: u32, face_size: u32) -> u32 {
 /// pyramid (`levels` levels) with an `n×n` grid of solid-angle-weighted samples, each the
 /// mean over its own footprint in `u` ([`sample_area`]): the grid spacing, `2/(size·n)` on
 /// the face plane, is about `2/(size·n·|p|)` radians at point `p`, which near a pole spans
-/// `1/sin θ` times more longitude.
+/// `1/sin θ` times more longitude. The cube faces `facing` (a turn about `+Y`, which
+/// leaves that longitude span as it is).
 #[allow(clippy::too_many_arguments)]
-pub fn cube_texel(pyramid: &[Vec4], width: u32, height: u32, levels: u32, face: u32, x: u32, y: u32, size: u32, n: u32) -> Vec4 {
+pub fn cube_texel(pyramid: &[Vec4], width: u32, height: u32, levels: u32, facing: Facing, face: u32, x: u32, y: u32, size: u32, n: u32) -> Vec4 {
     let s = size as f32;
     let nf = n as f32;
     let spacing = 2.0 / (s * nf);
@@ -187,7 +253,7 @@ pub fn cube_texel(pyramid: &[Vec4], width: u32, height: u32, levels: u32, face: 
             // Longitude spanned by one grid step: (spacing/r) / sin θ, sin θ = √(x²+z²)/r.
             let rho = math::sqrt(p.x * p.x + p.z * p.z);
             let window = if rho > 0.0 { spacing / rho * texels_per_radian } else { width as f32 };
-            acc += sample_area(pyramid, width, height, levels, dir_to_uv(p), window) * w;
+            acc += sample_area(pyramid, width, height, levels, dir_to_uv(facing.image_direction(p)), window) * w;
             wsum += w;
             i += 1;
         }

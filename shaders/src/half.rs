@@ -62,6 +62,57 @@ pub fn f16_bits_to_f32(h: u32) -> f32 {
     f32::from_bits(bits)
 }
 
+/// The bits of `x ≥ 0` as an unsigned float with a 5-bit exponent (bias 15, as binary16)
+/// and `mantissa` bits (6 for the 11-bit, 5 for the 10-bit channels of
+/// `R11F_G11F_B10F`; OpenGL 4.6 §2.3.4.3–4), rounded to nearest even. NaN and values
+/// `≤ 0` give 0; values past the largest finite one (`65024` with 6 bits, `64512` with 5)
+/// give that one, never ∞.
+#[inline]
+pub fn f32_to_unsigned_small_float(x: f32, mantissa: u32) -> u32 {
+    let max_bits = (30u32 << mantissa) | ((1u32 << mantissa) - 1);
+    #[allow(clippy::eq_op)]
+    if x != x || x <= 0.0 {
+        return 0;
+    }
+    let b = x.to_bits();
+    let exp = ((b >> 23) & 0xff) as i32;
+    let man = b & 0x7f_ffff;
+    let e = exp - 127 + 15;
+    if exp == 0xff || e >= 0x1f {
+        return max_bits;
+    }
+    let drop = 23 - mantissa;
+    let bits = if e <= 0 {
+        // Subnormal: m·2^(−14 − mantissa).
+        let shift = drop + (1 - e) as u32;
+        if shift > 24 {
+            return 0;
+        }
+        let full = man | 0x80_0000;
+        let m = full >> shift;
+        let rest = full & ((1u32 << shift) - 1);
+        let half = 1u32 << (shift - 1);
+        m + (rest > half || (rest == half && (m & 1) == 1)) as u32
+    } else {
+        let h = ((e as u32) << mantissa) | (man >> drop);
+        let rest = man & ((1u32 << drop) - 1);
+        let half = 1u32 << (drop - 1);
+        h + (rest > half || (rest == half && (h & 1) == 1)) as u32
+    };
+    if bits > max_bits { max_bits } else { bits }
+}
+
+/// The largest value of an 11-bit unsigned float (6-bit mantissa): `2¹⁵·(2 − 2⁻⁶)`.
+pub const UFLOAT11_MAX: f32 = 65024.0;
+
+/// An RGB value packed as `R11F_G11F_B10F` (`GL_UNSIGNED_INT_10F_11F_11F_REV`: red in
+/// bits 0–10, green 11–21, blue 22–31), each channel by [`f32_to_unsigned_small_float`]:
+/// negative and NaN channels become 0, channels past the format's range its largest value.
+#[inline]
+pub fn pack_r11g11b10f(r: f32, g: f32, b: f32) -> u32 {
+    f32_to_unsigned_small_float(r, 6) | (f32_to_unsigned_small_float(g, 6) << 11) | (f32_to_unsigned_small_float(b, 5) << 22)
+}
+
 /// Two radiance values packed as halves (`a` in the low 16 bits): NaN becomes 0 and
 /// magnitudes beyond [`HALF_MAX`] become ±`HALF_MAX`, so a sun of 10⁶ stays the brightest
 /// finite value rather than ∞.

@@ -22,22 +22,31 @@ use spirv_std::glam::{Vec3, Vec4};
 /// Number of SH coefficients up to band 2.
 pub const SH9: usize = 9;
 
-/// The nine real SH basis functions `Y_lm` at unit direction `d`, ordered
-/// `(0,0), (1,−1), (1,0), (1,1), (2,−2), (2,−1), (2,0), (2,1), (2,2)`.
+/// The polynomials of the nine real SH basis functions at unit direction `d`, ordered
+/// `(0,0), (1,−1), (1,0), (1,1), (2,−2), (2,−1), (2,0), (2,1), (2,2)`:
+/// `1, y, z, x, xy, yz, 3z² − 1, xz, x² − y²`.
+#[inline]
+pub fn sh9_polynomials(d: Vec3) -> [f32; SH9] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [1.0, y, z, x, x * y, y * z, 3.0 * z * z - 1.0, x * z, x * x - y * y]
+}
+
+/// The normalising constants `Kₖ` of the basis: `Y_k = Kₖ·Pₖ` ([`sh9_polynomials`]):
+/// `½√(1/π)`, `½√(3/π)`, `½√(15/π)`, `¼√(5/π)`, `¼√(15/π)`.
+pub const SH9_K: [f32; SH9] = [0.282_094_8, 0.488_602_5, 0.488_602_5, 0.488_602_5, 1.092_548_4, 1.092_548_4, 0.315_391_57, 1.092_548_4, 0.546_274_2];
+
+/// The nine real SH basis functions `Y_lm` at unit direction `d` (order as
+/// [`sh9_polynomials`]).
 #[inline]
 pub fn sh9_basis(d: Vec3) -> [f32; SH9] {
-    let (x, y, z) = (d.x, d.y, d.z);
-    [
-        0.282_094_8,
-        0.488_602_5 * y,
-        0.488_602_5 * z,
-        0.488_602_5 * x,
-        1.092_548_4 * x * y,
-        1.092_548_4 * y * z,
-        0.315_391_57 * (3.0 * z * z - 1.0),
-        1.092_548_4 * x * z,
-        0.546_274_2 * (x * x - y * y),
-    ]
+    let p = sh9_polynomials(d);
+    let mut y = [0.0; SH9];
+    let mut k = 0;
+    while k < SH9 {
+        y[k] = SH9_K[k] * p[k];
+        k += 1;
+    }
+    y
 }
 
 /// Cosine-lobe convolution factors `Âₗ/π` per coefficient.
@@ -54,6 +63,22 @@ pub fn sh9_irradiance(coeffs: &[Vec4; SH9], n: Vec3) -> Vec3 {
         k += 1;
     }
     e
+}
+
+/// `E(n)/π` as coefficients of [`sh9_polynomials`] of the unit normal, from radiance
+/// coefficients `coeffs`: `cₖ = (Âₗ/π)·Kₖ·L_k` ([`SH9_K`]). This is the form Filament's shader
+/// evaluates (`Irradiance_SphericalHarmonics` in `shaders/src/light_indirect.fs`, with
+/// cmgen's `--sh-shader` pre-scaling, `CubemapSH::preprocessSHForShader`): its
+/// `E/π = max(0, Σ cₖ Pₖ(n))`.
+#[inline]
+pub fn sh9_polynomial(coeffs: &[Vec4; SH9]) -> [Vec3; SH9] {
+    let mut out = [Vec3::ZERO; SH9];
+    let mut k = 0;
+    while k < SH9 {
+        out[k] = coeffs[k].truncate() * (SH9_COSINE[k] * SH9_K[k]);
+        k += 1;
+    }
+    out
 }
 
 /// `E(n)/π` at normal `n` by the exact cosine-weighted sum over every texel of `level` of

@@ -93,6 +93,8 @@ pub struct EquirectParams {
     pub levels: u32,
     /// The pyramid level written (by [`equirect_pyramid`]).
     pub level: u32,
+    /// Which way the image centre faces in the cube (`equirect::Facing` code).
+    pub facing: u32,
 }
 
 /// One texel of level `level` of the equirect's row pyramid, from level `level − 1` of the
@@ -120,7 +122,7 @@ pub fn equirect_to_cube(
 ) {
     let s = p.face_size;
     if id.x < s && id.y < s && id.z < cubemap::FACES {
-        let v = equirect::cube_texel(pyramid, p.width, p.height, p.levels, id.z, id.x, id.y, s, p.supersample);
+        let v = equirect::cube_texel(pyramid, p.width, p.height, p.levels, equirect::Facing::from_u32(p.facing), id.z, id.x, id.y, s, p.supersample);
         out[((id.z * s + id.y) * s + id.x) as usize] = v;
     }
 }

@@ -44,6 +44,11 @@ pub enum RoughnessMapping {
     /// mip resolves its lobe (Filament's and Bevy's log-roughness mappings aim for the
     /// same). Between the mirror and mip 1, `α` is interpolated linearly; above, `log α`.
     Geometric = 2,
+    /// `r = 1 − √(1 − m/(M − 1))`, the inverse of Filament's `lod = (M − 1)·r·(2 − r)`
+    /// (cmgen `lodToPerceptualRoughness`; Filament `perceptualRoughnessToLod` in
+    /// `shaders/src/light_indirect.fs`), a quadratic fit of `log₂ r` for a 256² cube with 5
+    /// mips.
+    Filament = 3,
 }
 
 impl RoughnessMapping {
@@ -53,6 +58,8 @@ impl RoughnessMapping {
             Self::Quadratic
         } else if code == 2 {
             Self::Geometric
+        } else if code == 3 {
+            Self::Filament
         } else {
             Self::Linear
         }
@@ -68,6 +75,7 @@ impl RoughnessMapping {
         match self {
             Self::Linear => t,
             Self::Quadratic => t * t,
+            Self::Filament => 1.0 - math::sqrt(math::max(1.0 - t, 0.0)),
             Self::Geometric => {
                 if mip == 0 {
                     0.0
@@ -93,6 +101,7 @@ impl RoughnessMapping {
         match self {
             Self::Linear => r * top,
             Self::Quadratic => math::sqrt(r) * top,
+            Self::Filament => r * (2.0 - r) * top,
             Self::Geometric => {
                 let alpha = r * r;
                 let m = mips as f32;

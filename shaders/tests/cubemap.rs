@@ -165,3 +165,23 @@ fn downsampling_conserves_energy() {
         assert!(rel < 1e-5, "level {level}: {rel:e}");
     }
 }
+
+/// Each facing is a turn about +Y: it keeps up and length, `cube_direction` undoes
+/// `image_direction`, and the image centre (splitsum's −Z) lands where the facing says.
+#[test]
+fn facings_turn_the_image_centre_about_up() {
+    use splitsum_shaders::choice::Choice;
+    use splitsum_shaders::equirect::Facing;
+    let centre = Vec3::new(0.0, 0.0, -1.0);
+    for (f, want) in [(Facing::NegZ, Vec3::NEG_Z), (Facing::PosX, Vec3::X), (Facing::PosZ, Vec3::Z), (Facing::NegX, Vec3::NEG_X)] {
+        assert_eq!(f.cube_direction(centre), want, "{}", f.name());
+        assert_eq!(f.image_direction(want), centre, "{}", f.name());
+        assert_eq!(f.cube_direction(Vec3::Y), Vec3::Y, "up stays up");
+        let d = Vec3::new(0.3, -0.5, 0.7);
+        assert!((f.image_direction(f.cube_direction(d)) - d).length() < 1e-7);
+        // A proper rotation: the triple product of the turned axes is +1.
+        let (x, y, z) = (f.cube_direction(Vec3::X), f.cube_direction(Vec3::Y), f.cube_direction(Vec3::Z));
+        assert!((x.cross(y).dot(z) - 1.0).abs() < 1e-7, "{} keeps handedness", f.name());
+        assert_eq!(Facing::from_u32(f.code()), f);
+    }
+}

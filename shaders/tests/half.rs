@@ -52,3 +52,42 @@ fn cleaning_a_texture_texel_keeps_radiance_finite_and_non_negative() {
     let v = clean_radiance(Vec4::new(f32::NAN, -3.0, f32::INFINITY, 2.5));
     assert_eq!(v, Vec4::new(0.0, 0.0, splitsum_shaders::math::MAX_RADIANCE, 2.5));
 }
+
+/// An unsigned small float's value from its bits (OpenGL 4.6 §2.3.4.3–4), written here from
+/// the definition: 5-bit exponent, bias 15, `m` mantissa bits, subnormals below 2⁻¹⁴.
+fn small_float_value(bits: u32, m: u32) -> f64 {
+    let e = (bits >> m) & 31;
+    let f = (bits & ((1 << m) - 1)) as f64 / (1u32 << m) as f64;
+    if e == 0 { f * 2f64.powi(-14) } else { (1.0 + f) * 2f64.powi(e as i32 - 15) }
+}
+
+/// `R11F_G11F_B10F` packing: every finite code of both widths round-trips, every midpoint
+/// between neighbours rounds to the even one and a hair either side to the nearer, and
+/// NaN, negatives, overflow and ∞ give 0, 0, the largest value and the largest value.
+#[test]
+fn unsigned_small_floats_round_to_nearest_even_and_never_overflow() {
+    use splitsum_shaders::half::{UFLOAT11_MAX, f32_to_unsigned_small_float as enc, pack_r11g11b10f};
+    for m in [6u32, 5] {
+        let max_code = (30u32 << m) | ((1 << m) - 1);
+        for c in 0..max_code {
+            let (a, b) = (small_float_value(c, m), small_float_value(c + 1, m));
+            assert_eq!(enc(a as f32, m), c, "code {c} of the {m}-bit mantissa round-trips");
+            let mid = 0.5 * (a + b);
+            assert_eq!(enc(mid as f32, m), if c % 2 == 0 { c } else { c + 1 }, "tie between {c} and {}", c + 1);
+            assert_eq!(enc((mid * (1.0 - 1e-6)) as f32, m), c);
+            assert_eq!(enc((mid * (1.0 + 1e-6)) as f32, m), c + 1);
+        }
+        assert_eq!(enc(small_float_value(max_code, m) as f32, m), max_code);
+        for v in [1e6f32, f32::INFINITY, f32::MAX] {
+            assert_eq!(enc(v, m), max_code, "{v} clamps to the largest value");
+        }
+        for v in [-1.0f32, f32::NEG_INFINITY, f32::NAN, 0.0, -0.0] {
+            assert_eq!(enc(v, m), 0, "{v} gives 0");
+        }
+    }
+    assert_eq!(small_float_value((30 << 6) | 63, 6), UFLOAT11_MAX as f64);
+    // 1.0: exponent 15, mantissa 0 in each channel; red in bits 0–10, blue in 22–31.
+    assert_eq!(pack_r11g11b10f(1.0, 0.0, 0.0), 15 << 6);
+    assert_eq!(pack_r11g11b10f(0.0, 1.0, 0.0), (15 << 6) << 11);
+    assert_eq!(pack_r11g11b10f(0.0, 0.0, 1.0), (15 << 5) << 22);
+}

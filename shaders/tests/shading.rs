@@ -125,3 +125,21 @@ fn geometric_mapping_round_trips() {
         }
     }
 }
+
+/// The Filament mapping is cmgen's `lodToPerceptualRoughness` (`r = 1 − √(1 − t)`, written
+/// here as cmgen writes it: `(√(a² + 4b·t) − a)/(2b)` with `a = 2, b = −1`), and `lod` is
+/// Filament's `perceptualRoughnessToLod`, `(M − 1)·r·(2 − r)`: the inverse on every mip.
+#[test]
+fn filament_mapping_is_cmgens_and_filaments_lod_inverts_it() {
+    let f = RoughnessMapping::Filament;
+    for mips in 2..=9u32 {
+        for m in 0..mips {
+            let t = m as f64 / (mips - 1) as f64;
+            let cmgen = if t != 0.0 { (((4.0 - 4.0 * t) as f64).sqrt() - 2.0) / -2.0 } else { 0.0 };
+            let r = f.roughness(m, mips);
+            assert!((r as f64 - cmgen).abs() < 1e-6, "M {mips}, mip {m}: {r} vs cmgen {cmgen}");
+            let lod = (mips - 1) as f64 * r as f64 * (2.0 - r as f64);
+            assert!((f.lod(r, mips) as f64 - lod).abs() < 1e-5 && (lod - m as f64).abs() < 1e-4, "M {mips}, mip {m}: lod {lod}");
+        }
+    }
+}

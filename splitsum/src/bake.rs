@@ -105,7 +105,7 @@ pub fn source_cube<K: Kernels>(k: &K, env: &Environment, settings: &Settings) ->
     match env {
         Environment::Equirect(e) => {
             let n = equirect::supersampling(size, e.width, settings.supersample_density);
-            Ok((k.equirect_to_cube(e, size, n)?, layout))
+            Ok((k.equirect_to_cube(e, size, n, settings.facing)?, layout))
         }
         Environment::Cube(c) => {
             let full_layout = CubeLayout::new(c.layout.size, CubeLayout::full_chain(c.layout.size));

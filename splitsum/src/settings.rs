@@ -1,5 +1,6 @@
 //! What a bake makes and how: [`Settings`] (every knob, with the one set of defaults and
-//! the one validation) and [`Products`] (which products).
+//! the one validation), [`Products`] (which products) and [`Target`] (whose conventions
+//! the files follow).
 
 use crate::error::{Error, Result};
 use crate::ktx2::Format;
@@ -7,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::prefilter::{self, RoughnessMapping};
 
 /// How the BRDF table is integrated.
@@ -30,6 +32,80 @@ impl TableMethod {
             TableMethod::Sampled => Masking::SmithSchlick,
         }
     }
+}
+
+/// Whose conventions a bake's files follow. Each engine target fixes, in
+/// [`Target::fixed`], the settings its loader and shaders assume (the equirect's facing,
+/// the roughness per mip, the mip count, the table's masking term) and, in
+/// `crate::output`, the files, their names and formats. The README cites the engine lines.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Target {
+    /// splitsum's own folder: every product, EXR and PNG views, `bake.json`.
+    Splitsum = 0,
+    /// The Khronos glTF-IBL-Sampler's files, as the glTF Sample Viewer reads them.
+    Khronos = 1,
+    /// Bevy's `EnvironmentMapLight` (the glTF-IBL-Sampler conventions Bevy documents; KTX2
+    /// with zstd, as Bevy's own environment maps).
+    Bevy = 2,
+    /// Filament's `IndirectLight` and `Skybox` (cmgen `--format=ktx --deploy`).
+    Filament = 3,
+}
+
+splitsum_shaders::choice!(Target: Splitsum => "splitsum", Khronos => "khronos", Bevy => "bevy", Filament => "filament");
+
+/// The settings an engine target fixes (`None`: any value).
+#[derive(Copy, Clone, Debug)]
+pub struct Fixed {
+    /// Which way the equirect's centre faces.
+    pub facing: Facing,
+    /// Roughness per mip.
+    pub mapping: Option<RoughnessMapping>,
+    /// Mips for a given mip-0 face size.
+    pub mips: Option<fn(u32) -> u32>,
+    /// The table's masking term (where the target has a table).
+    pub lut_masking: Option<Masking>,
+}
+
+impl Target {
+    /// The settings this target fixes, with where each comes from.
+    pub fn fixed(self) -> Fixed {
+        match self {
+            Target::Splitsum => Fixed { facing: Facing::NegZ, mapping: None, mips: None, lut_masking: None },
+            // glTF-IBL-Sampler `lib.cpp`: `_mipmapCount = floor(log2(_cubemapResolution))`,
+            // `roughness = currentMipLevel / (outputMipLevels - 1)`; its table uses
+            // `V_SmithGGXCorrelated` (`filter.frag`). Bevy reads mip
+            // `perceptual_roughness * (levels - 1)` (`environment_map.wesl`).
+            Target::Khronos | Target::Bevy => {
+                Fixed { facing: Facing::PosX, mapping: Some(RoughnessMapping::Linear), mips: Some(khronos_mips), lut_masking: Some(Masking::SmithCorrelated) }
+            }
+            // cmgen: levels from the base size down to 16² (`IBL_DEFAULT_MIN_LOD_SIZE`),
+            // `lodToPerceptualRoughness`; Filament's engine carries its own DFG table.
+            Target::Filament => Fixed { facing: Facing::PosZ, mapping: Some(RoughnessMapping::Filament), mips: Some(filament_mips), lut_masking: None },
+        }
+    }
+
+    /// What the target's engine reads: Khronos and Bevy a specular and an irradiance cube
+    /// and the table; Filament the specular cube and SH9 (its table is built in).
+    pub fn products(self) -> Products {
+        match self {
+            Target::Splitsum => Products::ALL,
+            Target::Khronos | Target::Bevy => Products { specular: true, irradiance: true, sh9: false, lut: true },
+            Target::Filament => Products { specular: true, irradiance: false, sh9: true, lut: false },
+        }
+    }
+}
+
+/// glTF-IBL-Sampler's mip count: `floor(log₂ size)`, at least 1.
+fn khronos_mips(size: u32) -> u32 {
+    size.max(2).ilog2()
+}
+
+/// cmgen's mip count: from `size` down to 16² faces, `log₂ size + 1 − 4`, or the whole
+/// chain for faces of 16² or less.
+fn filament_mips(size: u32) -> u32 {
+    let chain = CubeLayout::full_chain(size.max(1));
+    if size > 16 { chain - 4 } else { chain }
 }
 
 /// Serde for a [`Choice`]: by its name.
@@ -99,6 +175,12 @@ pub struct Settings {
     /// Texel format of the KTX2 files.
     #[serde(with = "named")]
     pub format: Format,
+    /// Which way the equirect's centre faces in the cube (`-z`: splitsum's).
+    #[serde(with = "named")]
+    pub facing: Facing,
+    /// Whose conventions the files follow.
+    #[serde(with = "named")]
+    pub target: Target,
 }
 
 impl Default for Settings {
@@ -121,6 +203,8 @@ impl Default for Settings {
             lut_method: TableMethod::Quadrature,
             lut_masking: Masking::SmithCorrelated,
             format: Format::Auto,
+            facing: Facing::NegZ,
+            target: Target::Splitsum,
         }
     }
 }
@@ -169,6 +253,45 @@ impl Settings {
         }
         if self.lut_method == TableMethod::Sampled && self.lut_masking != Masking::SmithSchlick {
             return Err(Error::setting("lut_masking", "correlated needs the quadrature table method (the sampled table is Smith–Schlick only)"));
+        }
+        self.check_target()
+    }
+
+    /// These settings with `target` and the values it fixes (the mip count for the
+    /// current `size`).
+    pub fn with_target(self, target: Target) -> Self {
+        let f = target.fixed();
+        Self {
+            target,
+            facing: f.facing,
+            mapping: f.mapping.unwrap_or(self.mapping),
+            mips: f.mips.map_or(self.mips, |m| m(self.size)),
+            lut_masking: f.lut_masking.unwrap_or(self.lut_masking),
+            ..self
+        }
+    }
+
+    /// Every value the target fixes agrees with it (`Error::Setting` naming the field).
+    fn check_target(&self) -> Result<()> {
+        let t = self.target;
+        let f = t.fixed();
+        let differs = |field: &'static str, what: String| {
+            Err(Error::setting(field, format!("{what} for the {} target, whose engine reads its files that way", t.name())))
+        };
+        if self.facing != f.facing {
+            return differs("facing", format!("must be {}, not {},", f.facing.name(), self.facing.name()));
+        }
+        if let Some(m) = f.mapping.filter(|&m| m != self.mapping) {
+            return differs("mapping", format!("must be {}, not {},", m.name(), self.mapping.name()));
+        }
+        if let Some(n) = f.mips.map(|m| m(self.size)).filter(|&n| n != self.mips) {
+            return differs("mips", format!("must be {n} for {0}² faces, not {1},", self.size, self.mips));
+        }
+        if let Some(m) = f.lut_masking.filter(|&m| m != self.lut_masking) {
+            return differs("lut_masking", format!("must be {}, not {},", m.name(), self.lut_masking.name()));
+        }
+        if t == Target::Filament && self.format != Format::Auto {
+            return differs("format", format!("must be auto (cmgen's R11F_G11F_B10F), not {},", self.format.name()));
         }
         Ok(())
     }

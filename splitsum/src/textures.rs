@@ -360,7 +360,10 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) ->
         Shape::Equirect => {
             let source_size = settings.source_size;
             let n = splitsum_shaders::equirect::supersampling(source_size, size.width, settings.supersample_density);
-            Ok((g.pyramid_to_cube(&texels.buffer, size.width, size.height, source_size, n)?, CubeLayout::new(source_size, CubeLayout::full_chain(source_size))))
+            Ok((
+                g.pyramid_to_cube(&texels.buffer, size.width, size.height, source_size, n, settings.facing)?,
+                CubeLayout::new(source_size, CubeLayout::full_chain(source_size)),
+            ))
         }
         Shape::Cube => bake::cube_source(g, texels, size.width, settings),
     }

@@ -13,7 +13,7 @@ mod view;
 use crate::environment;
 use crate::files;
 use crate::ktx2::Format;
-use crate::settings::{Products, Settings, TableMethod};
+use crate::settings::{Products, Settings, TableMethod, Target};
 use crate::{Backend, BackendKind};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
@@ -215,12 +215,20 @@ pub struct QualityArgs {
     /// Face size of the source cube the products are filtered from [default: --size].
     #[arg(long)]
     pub source_size: Option<u32>,
-    /// Specular mips, one roughness each [default: down to 8×8 faces].
+    /// Whose conventions the files follow: splitsum's folder, or what the Khronos
+    /// glTF-IBL-Sampler (glTF Sample Viewer), Bevy or Filament's cmgen write and their
+    /// engines read (README, "Engine targets"). An engine target fixes the equirect's
+    /// facing, the roughness per mip, the mip count and the table's masking term.
+    #[arg(long, value_parser = choice::<Target>(), default_value = DEFAULT.target.name())]
+    pub target: Target,
+    /// Specular mips, one roughness each [default: down to 8×8 faces; the target's count
+    /// for an engine target].
     #[arg(long)]
     pub mips: Option<u32>,
-    /// How roughness is spread over the mips.
-    #[arg(long, value_parser = choice::<RoughnessMapping>(), default_value = DEFAULT.mapping.name())]
-    pub mapping: RoughnessMapping,
+    /// How roughness is spread over the mips [default: geometric; the target's for an
+    /// engine target].
+    #[arg(long, value_parser = choice::<RoughnessMapping>())]
+    pub mapping: Option<RoughnessMapping>,
     /// GGX samples per texel of specular mip 1 (the default, with --sample-growth 2, is the
     /// best end-to-end error per millisecond measured by `runner report` on city.exr).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = DEFAULT.samples)]
@@ -271,14 +279,17 @@ pub struct QualityArgs {
 impl QualityArgs {
     /// The bake settings these flags describe.
     pub fn settings(&self) -> Settings {
-        let mips = self.mips.unwrap_or_else(|| Settings::default_mips(self.size));
+        // What the target fixes fills the flags not given; a given flag that differs is
+        // refused by Settings::validate, by its name.
+        let fixed = self.target.fixed();
+        let mips = self.mips.or(fixed.mips.map(|m| m(self.size))).unwrap_or_else(|| Settings::default_mips(self.size));
         let source_size = self.source_size.unwrap_or(self.size);
         let d = Settings::default();
         Settings {
             size: self.size,
             source_size,
             mips,
-            mapping: self.mapping,
+            mapping: self.mapping.or(fixed.mapping).unwrap_or(d.mapping),
             samples: self.samples,
             sample_growth: self.sample_growth,
             exact_sums: !self.sampled_only,
@@ -291,8 +302,10 @@ impl QualityArgs {
             lut_size: self.lut_size,
             lut_samples: self.lut_samples,
             lut_method: self.lut_method,
-            lut_masking: self.lut_masking.unwrap_or(self.lut_method.default_masking()),
+            lut_masking: self.lut_masking.or(fixed.lut_masking).unwrap_or(self.lut_method.default_masking()),
             format: self.format,
+            facing: fixed.facing,
+            target: self.target,
         }
     }
 }
@@ -342,7 +355,9 @@ impl ShadingFlags {
 }
 
 /// The flag of each `Settings` field, for errors in the user's own terms.
-const SETTING_FLAGS: [(&str, &str); 17] = [
+const SETTING_FLAGS: [(&str, &str); 19] = [
+    ("target", "--target"),
+    ("facing", "--target"),
     ("size", "--size"),
     ("source_size", "--source-size"),
     ("mips", "--mips"),

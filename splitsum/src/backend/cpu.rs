@@ -9,6 +9,7 @@ use indicatif::ProgressBar;
 use rayon::prelude::*;
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
+use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance;
 use splitsum_shaders::kernels::{self, ProbeParams};
@@ -83,14 +84,14 @@ impl Kernels for Cpu {
         Ok(texels[start as usize..(start + count) as usize].to_vec())
     }
 
-    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Vec<Vec4>> {
+    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Vec<Vec4>> {
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
         let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
         let pyramid = equirect_pyramid(env);
         let levels = equirect::pyramid_levels(env.width);
         let bar = progress("equirect", (FACES * size) as u64);
         let level0 = &mut texels[..(FACES * size * size) as usize];
-        fill_level(level0, size, &bar, |face, x, y| equirect::cube_texel(&pyramid, env.width, env.height, levels, face, x, y, size, supersample));
+        fill_level(level0, size, &bar, |face, x, y| equirect::cube_texel(&pyramid, env.width, env.height, levels, facing, face, x, y, size, supersample));
         bar.finish_and_clear();
         self.build_mips(&mut texels, layout)?;
         Ok(texels)

@@ -11,7 +11,9 @@ use super::kernels::{Kernels, Prefilter, chunks};
 use crate::error::{Error, Result};
 use crate::texture::{Equirect, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::choice::Choice;
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
+use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
 use splitsum_shaders::kernels::{DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, ResolveParams, TableParams};
@@ -393,10 +395,10 @@ impl Gpu {
     /// The source cube (faces of `size`, full mip chain) from the `w`×`h` equirect in level
     /// 0 of `pyramid` (a buffer of `equirect::pyramid_len` texels): its row pyramid, then
     /// `supersample`² points per cube texel.
-    pub fn pyramid_to_cube(&self, pyramid: &wgpu::Buffer, w: u32, h: u32, size: u32, supersample: u32) -> Result<Texels> {
+    pub fn pyramid_to_cube(&self, pyramid: &wgpu::Buffer, w: u32, h: u32, size: u32, supersample: u32, facing: Facing) -> Result<Texels> {
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
         let levels = equirect::pyramid_levels(w);
-        let base = EquirectParams { width: w, height: h, face_size: size, supersample, levels, level: 0 };
+        let base = EquirectParams { width: w, height: h, face_size: size, supersample, levels, level: 0, facing: facing.code() };
         let params: Vec<EquirectParams> = (1..levels).map(|level| EquirectParams { level, ..base }).collect();
         let dispatches: Vec<Dispatch> = params
             .iter()
@@ -467,17 +469,17 @@ impl Kernels for Gpu {
         Ok(out)
     }
 
-    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Texels> {
+    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Texels> {
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
         let (w, h) = (env.width, env.height);
         let pyramid_bytes = bytes(equirect::pyramid_len(w, h) as u64);
         if !self.fits(&format!("resampling the {w}×{h} equirect (its row pyramid)"), &[pyramid_bytes, bytes(layout.texel_count() as u64)]) {
-            return self.upload("source cube", &Cpu.equirect_to_cube(env, size, supersample)?);
+            return self.upload("source cube", &Cpu.equirect_to_cube(env, size, supersample, facing)?);
         }
         let mut texels = env.texels.clone();
         texels.resize(equirect::pyramid_len(w, h) as usize, Vec4::ZERO);
         let pyramid = self.upload_bytes("equirect pyramid", bytemuck::cast_slice(&texels));
-        self.pyramid_to_cube(&pyramid, w, h, size, supersample)
+        self.pyramid_to_cube(&pyramid, w, h, size, supersample, facing)
     }
 
     fn build_mips(&self, cube: &mut Texels, layout: CubeLayout) -> Result<()> {

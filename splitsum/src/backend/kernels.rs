@@ -4,6 +4,7 @@ use crate::error::Result;
 use crate::texture::{Equirect, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::kernels::ProbeParams;
 use splitsum_shaders::math::CHUNK;
@@ -50,8 +51,8 @@ pub trait Kernels {
     /// `count` texels of `texels` from index `start`.
     fn slice(&self, texels: &Self::Texels, start: u32, count: u32) -> Result<Self::Texels>;
     /// Level 0 of a cube with faces of `size` resampled from `env` with `supersample`²
-    /// points per texel, and its full mip chain.
-    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Self::Texels>;
+    /// points per texel, the image centre facing `facing`, and its full mip chain.
+    fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Self::Texels>;
     /// Fills levels 1.. of `cube` from its level 0.
     fn build_mips(&self, cube: &mut Self::Texels, layout: CubeLayout) -> Result<()>;
     /// The prefiltered specular cube of `job` from `src`.

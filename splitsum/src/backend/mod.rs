@@ -17,6 +17,7 @@ use crate::error::{Error, Result};
 use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::kernels::ProbeParams;
 
@@ -110,10 +111,10 @@ impl Backend {
     }
 
     /// The source cube: `env` resampled to faces of `size` with `supersample`² points per
-    /// texel, and its full mip chain.
+    /// texel (facing splitsum's way, `Facing::NegZ`), and its full mip chain.
     pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Cube> {
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
-        with_kernels!(self, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample)?)? }))
+        with_kernels!(self, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, Facing::NegZ)?)? }))
     }
 
     /// Fills levels 1.. of `cube` from its level 0.
