@@ -1,5 +1,5 @@
 //! KTX 2.0 writer for float cube maps with mips (Khronos, "KTX File Format Specification",
-//! version 2.0, §3–§4), no supercompression.
+//! version 2.0, §3–§4), and 2D tables; optionally Zstandard-supercompressed.
 //!
 //! Layout: identifier, header, index, level index (the `ktx2` crate's `Header` and
 //! `LevelIndex`), data format descriptor (the `ktx2` crate's basic DFD block for the
@@ -14,7 +14,7 @@
 
 use crate::error::Result;
 use crate::files::write_atomic;
-use crate::texture::Cube;
+use crate::texture::{Cube, Lut};
 use splitsum_shaders::half::f32_to_f16_bits;
 use std::io::Write;
 use std::path::Path;
@@ -70,9 +70,13 @@ fn round_up(x: usize, to: usize) -> usize {
 
 /// The data format descriptor of `format` (`dfdTotalSize`, then the basic block the
 /// `ktx2` crate builds from the format's description, as libktx's `createDFDUnpacked`
-/// does), and the header's `typeSize`.
-fn dfd(format: ::ktx2::Format) -> (Vec<u8>, u32) {
-    let (basic, type_size) = ::ktx2::dfd::Basic::from_format(format).expect("RGBA float formats have a descriptor");
+/// does), and the header's `typeSize`. A supercompressed file's descriptor has
+/// `bytesPlane0 = 0` (§3.10.2: its levels are "unsized").
+fn dfd(format: ::ktx2::Format, supercompressed: bool) -> (Vec<u8>, u32) {
+    let (mut basic, type_size) = ::ktx2::dfd::Basic::from_format(format).expect("float formats have a descriptor");
+    if supercompressed {
+        basic.bytes_planes[0] = 0;
+    }
     let block = ::ktx2::dfd::Block::Basic(basic).to_vec();
     let mut d = (4 + block.len() as u32).to_le_bytes().to_vec();
     d.extend_from_slice(&block);
@@ -93,44 +97,80 @@ fn kv(key: &str, value: &str) -> Vec<u8> {
     entry
 }
 
+/// Zstandard supercompression of every level (KTX 2.0 §3.12.2, scheme 2), as Bevy's
+/// loader and its own environment maps use; libktx inflates it on load.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Supercompression {
+    /// Levels stored as they are.
+    None,
+    /// Each level one Zstandard frame (`ruzstd`, its fastest level, about zstd's level 1).
+    Zstd,
+}
+
 /// Encodes `cube` as a KTX2 cube map in `format` (see the module's overflow rule).
 pub fn encode(cube: &Cube, format: Format) -> (Vec<u8>, Written) {
-    let format = format.resolve(cube);
-    let (kformat, bytes) = match format {
-        Format::Rgba32f => (::ktx2::Format::R32G32B32A32_SFLOAT, 4u32),
-        _ => (::ktx2::Format::R16G16B16A16_SFLOAT, 2u32),
-    };
-    let vk_format = kformat.value();
-    let mut written = Written { vk_format, clamped: 0, max_value: max_value(cube) };
-    let layout = cube.layout;
-    let levels = layout.levels as usize;
-    let texel_bytes = 4 * bytes as usize;
-    let align = if texel_bytes % 4 == 0 { texel_bytes } else { texel_bytes * 4 };
+    encode_with(cube, format, Supercompression::None)
+}
 
-    // Level payloads.
-    let mut payloads: Vec<Vec<u8>> = Vec::with_capacity(levels);
-    for level in 0..layout.levels {
-        let mut p = Vec::new();
-        for t in cube.level(level) {
-            for v in [t.x, t.y, t.z, t.w] {
-                if bytes == 4 {
-                    p.extend_from_slice(&v.to_le_bytes());
-                } else {
-                    let c = if v > HALF_MAX {
-                        written.clamped += 1;
-                        HALF_MAX
+/// Encodes `cube` as a KTX2 cube map in `format`, supercompressed by `sc`.
+pub fn encode_with(cube: &Cube, format: Format, sc: Supercompression) -> (Vec<u8>, Written) {
+    let format = format.resolve(cube);
+    let kformat = match format {
+        Format::Rgba32f => ::ktx2::Format::R32G32B32A32_SFLOAT,
+        _ => ::ktx2::Format::R16G16B16A16_SFLOAT,
+    };
+    let mut written = Written { vk_format: kformat.value(), clamped: 0, max_value: max_value(cube) };
+    let payloads: Vec<Vec<u8>> = (0..cube.layout.levels)
+        .map(|level| {
+            let mut p = Vec::new();
+            for t in cube.level(level) {
+                for v in [t.x, t.y, t.z, t.w] {
+                    if format == Format::Rgba32f {
+                        p.extend_from_slice(&v.to_le_bytes());
                     } else {
-                        v
-                    };
-                    p.extend_from_slice(&(f32_to_f16_bits(c) as u16).to_le_bytes());
+                        let c = if v > HALF_MAX {
+                            written.clamped += 1;
+                            HALF_MAX
+                        } else {
+                            v
+                        };
+                        p.extend_from_slice(&(f32_to_f16_bits(c) as u16).to_le_bytes());
+                    }
                 }
             }
-        }
-        payloads.push(p);
-    }
+            p
+        })
+        .collect();
+    (container(kformat, cube.layout.size, 6, payloads, sc), written)
+}
 
+/// Encodes the BRDF table as a 2D KTX2 `R16G16_SFLOAT` texture: red `A`, green `B`, `x`
+/// = n·v, rows top to bottom = roughness from 0 (Bevy's `dfg.ktx2` layout).
+pub fn encode_table(lut: &Lut, sc: Supercompression) -> Vec<u8> {
+    let mut p = Vec::with_capacity(lut.texels.len() * 4);
+    for t in &lut.texels {
+        for v in [t.x, t.y] {
+            p.extend_from_slice(&(f32_to_f16_bits(v) as u16).to_le_bytes());
+        }
+    }
+    container(::ktx2::Format::R16G16_SFLOAT, lut.size, 1, vec![p], sc)
+}
+
+/// The KTX2 file of square `size`² images in `kformat`, `faces` (6: a cube; 1: 2D) per
+/// level, `payloads[level]` holding each level's faces in order.
+fn container(kformat: ::ktx2::Format, size: u32, faces: u32, payloads: Vec<Vec<u8>>, sc: Supercompression) -> Vec<u8> {
+    let levels = payloads.len();
+    let (dfd_bytes, type_size) = dfd(kformat, sc != Supercompression::None);
+    // Unsupercompressed levels align to lcm(texel size, 4) (§3.9.7); supercompressed ones
+    // need none, and their descriptor's bytesPlane0 is 0 (§3.10.2, "unsized").
+    let texel_bytes = payloads[0].len() / (faces as usize * size as usize * size as usize);
+    let (align, stored): (usize, Vec<Vec<u8>>) = match sc {
+        Supercompression::None => (if texel_bytes % 4 == 0 { texel_bytes } else { texel_bytes * 4 }, payloads.clone()),
+        Supercompression::Zstd => {
+            (1, payloads.iter().map(|p| ruzstd::encoding::compress_to_vec(p.as_slice(), ruzstd::encoding::CompressionLevel::Fastest)).collect())
+        }
+    };
     let level_index_len = ::ktx2::LevelIndex::LENGTH * levels;
-    let (dfd_bytes, type_size) = dfd(kformat);
     let dfd_offset = ::ktx2::Header::LENGTH + level_index_len;
     let mut kvd = kv("KTXorientation", "rd");
     kvd.extend(kv("KTXwriter", concat!("splitsum ", env!("CARGO_PKG_VERSION"))));
@@ -141,19 +181,22 @@ pub fn encode(cube: &Cube, format: Format) -> (Vec<u8>, Written) {
     let mut offsets = vec![0usize; levels];
     for level in (0..levels).rev() {
         offsets[level] = data_start;
-        data_start = round_up(data_start + payloads[level].len(), align);
+        data_start = round_up(data_start + stored[level].len(), align);
     }
 
     let header = ::ktx2::Header {
         format: Some(kformat),
         type_size,
-        pixel_width: layout.size,
-        pixel_height: layout.size,
+        pixel_width: size,
+        pixel_height: size,
         pixel_depth: 0,
         layer_count: 0,
-        face_count: 6,
-        level_count: layout.levels,
-        supercompression_scheme: None,
+        face_count: faces,
+        level_count: levels as u32,
+        supercompression_scheme: match sc {
+            Supercompression::None => None,
+            Supercompression::Zstd => Some(::ktx2::SupercompressionScheme::Zstandard),
+        },
         index: ::ktx2::Index {
             dfd_byte_offset: dfd_offset as u32,
             dfd_byte_length: dfd_bytes.len() as u32,
@@ -165,21 +208,36 @@ pub fn encode(cube: &Cube, format: Format) -> (Vec<u8>, Written) {
     };
     let mut out = header.as_bytes().to_vec();
     for level in 0..levels {
-        let len = payloads[level].len() as u64;
-        out.extend_from_slice(&::ktx2::LevelIndex { byte_offset: offsets[level] as u64, byte_length: len, uncompressed_byte_length: len }.as_bytes());
+        let index = ::ktx2::LevelIndex {
+            byte_offset: offsets[level] as u64,
+            byte_length: stored[level].len() as u64,
+            uncompressed_byte_length: payloads[level].len() as u64,
+        };
+        out.extend_from_slice(&index.as_bytes());
     }
     out.extend_from_slice(&dfd_bytes);
     out.extend_from_slice(&kvd);
     for level in (0..levels).rev() {
         out.resize(offsets[level], 0);
-        out.extend_from_slice(&payloads[level]);
+        out.extend_from_slice(&stored[level]);
     }
-    (out, written)
+    out
 }
 
 /// Writes `cube` to `path` as KTX2 (atomically).
 pub fn write(path: &Path, cube: &Cube, format: Format) -> Result<Written> {
-    let (bytes, written) = encode(cube, format);
+    write_with(path, cube, format, Supercompression::None)
+}
+
+/// Writes `cube` to `path` as KTX2 supercompressed by `sc` (atomically).
+pub fn write_with(path: &Path, cube: &Cube, format: Format, sc: Supercompression) -> Result<Written> {
+    let (bytes, written) = encode_with(cube, format, sc);
     write_atomic(path, |w| w.write_all(&bytes))?;
     Ok(written)
+}
+
+/// Writes the BRDF table to `path` as a 2D `R16G16_SFLOAT` KTX2 ([`encode_table`]).
+pub fn write_table(path: &Path, lut: &Lut, sc: Supercompression) -> Result<()> {
+    let bytes = encode_table(lut, sc);
+    write_atomic(path, |w| w.write_all(&bytes))
 }

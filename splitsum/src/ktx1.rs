@@ -1,0 +1,81 @@
+//! KTX 1.1 cube maps as Filament loads them (Khronos, "KTX File Format Specification"
+//! 1.1; Filament `libs/ktxreader/src/Ktx1Reader.cpp`): cmgen's `_ibl.ktx` and
+//! `_skybox.ktx`.
+//!
+//! Layout: the 12-byte identifier, thirteen `u32` header fields, key/value pairs (each
+//! `keyAndValueByteSize`, `key\0value\0`, padded to 4 bytes), then per level its
+//! `imageSize` (one face, for a cube) and the six faces +X, −X, +Y, −Y, +Z, −Z, rows top to
+//! bottom. Texels are `R11F_G11F_B10F` (`half::pack_r11g11b10f`: 4 bytes, no padding).
+//!
+//! The header carries what cmgen writes: `glType` and `glInternalFormat`
+//! `GL_R11F_G11F_B10F`, `glTypeSize` 1, `glFormat` and `glBaseInternalFormat` `GL_RGB`.
+//! Filament's `toPixelDataType` maps only that `glType` (not the standard
+//! `GL_UNSIGNED_INT_10F_11F_11F_REV`) to `UINT_10F_11F_11F_REV`.
+//!
+//! **Overflow rule**: the format's largest value is 65024 (`half::UFLOAT11_MAX`, blue
+//! 64512); larger values are written as it and counted, negative values as 0.
+
+use crate::error::Result;
+use crate::files::write_atomic;
+use crate::texture::Cube;
+use splitsum_shaders::half::{UFLOAT11_MAX, pack_r11g11b10f};
+use std::io::Write;
+use std::path::Path;
+
+/// The KTX 1.1 identifier.
+pub const IDENTIFIER: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x31, 0x31, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
+/// `GL_R11F_G11F_B10F`.
+pub const GL_R11F_G11F_B10F: u32 = 0x8C3A;
+/// `GL_RGB`.
+pub const GL_RGB: u32 = 0x1907;
+
+/// What writing a cube did to its values.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Written {
+    /// Channel values above the format's range, written as its largest value.
+    pub clamped: u64,
+    /// The largest value in the cube.
+    pub max_value: f32,
+}
+
+/// Encodes `cube` (every level) as a KTX 1.1 `R11F_G11F_B10F` cube map with `metadata`
+/// key/value pairs.
+pub fn encode(cube: &Cube, metadata: &[(&str, &str)]) -> (Vec<u8>, Written) {
+    let layout = cube.layout;
+    let mut written = Written::default();
+    let mut kvd = Vec::new();
+    for (key, value) in metadata {
+        let len = key.len() + 1 + value.len() + 1;
+        kvd.extend_from_slice(&(len as u32).to_le_bytes());
+        kvd.extend_from_slice(key.as_bytes());
+        kvd.push(0);
+        kvd.extend_from_slice(value.as_bytes());
+        kvd.push(0);
+        kvd.resize(kvd.len().div_ceil(4) * 4, 0);
+    }
+    let header = [0x0403_0201, GL_R11F_G11F_B10F, 1, GL_RGB, GL_R11F_G11F_B10F, GL_RGB, layout.size, layout.size, 0, 0, 6, layout.levels, kvd.len() as u32];
+    let mut out = IDENTIFIER.to_vec();
+    for v in header {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&kvd);
+    for level in 0..layout.levels {
+        let s = layout.level_size(level);
+        out.extend_from_slice(&(4 * s * s).to_le_bytes());
+        for t in cube.level(level) {
+            for v in [t.x, t.y, t.z] {
+                written.max_value = written.max_value.max(v);
+                written.clamped += (v > UFLOAT11_MAX) as u64;
+            }
+            out.extend_from_slice(&pack_r11g11b10f(t.x, t.y, t.z).to_le_bytes());
+        }
+    }
+    (out, written)
+}
+
+/// Writes `cube` to `path` as KTX 1.1 ([`encode`]), atomically.
+pub fn write(path: &Path, cube: &Cube, metadata: &[(&str, &str)]) -> Result<Written> {
+    let (bytes, written) = encode(cube, metadata);
+    write_atomic(path, |w| w.write_all(&bytes))?;
+    Ok(written)
+}
