@@ -1,16 +1,21 @@
-//! A bake written as a folder: KTX2 cubes, EXR and PNG views of each product, the SH9
-//! coefficients, and `bake.json` (what was baked, how, from what, and how long it took).
+//! A bake written as a folder: for the `splitsum` target, KTX2 cubes, EXR and PNG views of
+//! each product, the SH9 coefficients; for an engine target, the files its engine loads,
+//! named and encoded as its own baker writes them ([`engine_files`]); and always
+//! `bake.json` (what was baked, how, from what, and how long it took).
 
 use crate::bake::{Baked, Timing};
 use crate::environment::InputReport;
 use crate::error::Result;
 use crate::files;
+use crate::ktx1;
 use crate::ktx2;
+use crate::ktx2::Supercompression;
 use crate::preview;
-use crate::settings::Settings;
+use crate::settings::{Settings, Target};
 use crate::texture::{Cube, Sh9};
 use serde::Serialize;
-use splitsum_shaders::irradiance::{SH9, SH9_COSINE};
+use splitsum_shaders::choice::Choice;
+use splitsum_shaders::irradiance::{SH9, SH9_COSINE, sh9_polynomial};
 use splitsum_shaders::tonemap::Tonemapper;
 use std::path::Path;
 
@@ -24,6 +29,9 @@ pub struct OutputFile {
     /// How writing it changed values (KTX2 only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub written: Option<ktx2::Written>,
+    /// How writing it changed values (KTX 1.1 only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub written_ktx1: Option<ktx1::Written>,
 }
 
 /// `bake.json`: what was baked, how, from what, and how long it took.
@@ -117,15 +125,23 @@ struct ShFile<'a> {
     irradiance_over_pi: [[f64; 3]; 9],
 }
 
-/// Writes every baked product into `dir` (created if missing), each file atomically, and
-/// `bake.json` last.
-pub fn write(dir: &Path, baked: &Baked, settings: &Settings, manifest_base: Manifest) -> Result<Manifest> {
+/// Writes every baked product into `dir` (created if missing) in the files of
+/// `settings.target`, each file atomically, and `bake.json` last. `name` names the bake
+/// where a target's file names carry it (Filament's `NAME_ibl.ktx`): the output folder's
+/// name, as cmgen's `--deploy` folder.
+pub fn write(dir: &Path, name: &str, baked: &Baked, settings: &Settings, manifest_base: Manifest) -> Result<Manifest> {
     let _step = crate::progress::step("writing the files", None);
     files::create_folder(dir)?;
     let mut manifest = manifest_base;
+    if settings.target != Target::Splitsum {
+        manifest.files = engine_files(dir, name, baked, settings)?;
+        manifest.conventions = target_conventions(settings.target).to_vec();
+        manifest.timings = baked.timings.clone();
+        return write_manifest(dir, manifest);
+    }
     let mut files_out = Vec::new();
     let mut add = |name: &str, what: String, written: Option<ktx2::Written>| {
-        files_out.push(OutputFile { name: name.to_string(), what, written });
+        files_out.push(OutputFile { name: name.to_string(), what, written, written_ktx1: None });
     };
     let exposure = preview::auto_exposure(baked.source.level(0));
     let save_png = |name: &str, pic: &preview::Picture| -> Result<()> {
@@ -176,9 +192,126 @@ pub fn write(dir: &Path, baked: &Baked, settings: &Settings, manifest_base: Mani
     if let (Some(sh), Some(irr)) = (&baked.sh9, &baked.irradiance) {
         manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
     }
+    write_manifest(dir, manifest)
+}
+
+fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
     let json = serde_json::to_string_pretty(&manifest).expect("serialisable");
     files::write_atomic(&dir.join("bake.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
     Ok(manifest)
+}
+
+/// The files an engine target's loader reads, written into `dir`: only those (a
+/// product the engine does not read is neither baked, see `Target::products`, nor
+/// written). The README cites the engine lines that load each.
+///
+/// - `khronos`: `ggx/specular.ktx2` (RGBA16F, or RGBA32F past 65504 with format `auto`),
+///   `lambertian/diffuse.ktx2` (E/π), `lut_ggx.png` (8-bit, R = A, G = B, rows from
+///   roughness 0 at the top), the names and layout of the glTF Sample Viewer's
+///   environments (glTF-Sample-Environments) and glTF-IBL-Sampler's PNG table.
+/// - `bevy`: `specular.ktx2`, `diffuse.ktx2` and `dfg.ktx2` (`R16G16_SFLOAT`, R = A,
+///   G = B, Bevy's `DfgLut` layout), every one Zstandard-supercompressed as Bevy's own
+///   environment maps.
+/// - `filament`: `NAME_ibl.ktx` (specular mips, KTX 1.1 `R11F_G11F_B10F`, SH in its `sh`
+///   metadata), `NAME_skybox.ktx` (the source cube's level 0) and `sh.txt`: cmgen
+///   `--format=ktx --deploy`.
+pub fn engine_files(dir: &Path, name: &str, baked: &Baked, settings: &Settings) -> Result<Vec<OutputFile>> {
+    let mut out = Vec::new();
+    let mut add = |name: String, what: &str, written: Option<ktx2::Written>, written_ktx1: Option<ktx1::Written>| {
+        out.push(OutputFile { name, what: what.into(), written, written_ktx1 });
+    };
+    let missing = |what: &str| crate::error::Error::Invalid(format!("the {} target needs the {what}, which was not baked", settings.target.name()));
+    match settings.target {
+        Target::Splitsum => unreachable!("the splitsum folder is written by output::write"),
+        Target::Khronos | Target::Bevy => {
+            let khronos = settings.target == Target::Khronos;
+            let (spec_name, diffuse_name, sc) = if khronos {
+                ("ggx/specular.ktx2", "lambertian/diffuse.ktx2", Supercompression::None)
+            } else {
+                ("specular.ktx2", "diffuse.ktx2", Supercompression::Zstd)
+            };
+            if khronos {
+                files::create_folder(&dir.join("ggx"))?;
+                files::create_folder(&dir.join("lambertian"))?;
+            }
+            let spec = baked.specular.as_ref().ok_or_else(|| missing("specular cube"))?;
+            let w = ktx2::write_with(&dir.join(spec_name), spec, settings.format, sc)?;
+            report_clamp(spec_name, &w);
+            add(spec_name.into(), "GGX-prefiltered radiance, mip m at perceptual roughness m/(mips-1)", Some(w), None);
+            let irr = baked.irradiance.as_ref().ok_or_else(|| missing("irradiance cube"))?;
+            let w = ktx2::write_with(&dir.join(diffuse_name), irr, settings.format, sc)?;
+            report_clamp(diffuse_name, &w);
+            add(diffuse_name.into(), "irradiance divided by pi (Lambertian-filtered radiance)", Some(w), None);
+            let lut = baked.lut.as_ref().ok_or_else(|| missing("BRDF table"))?;
+            if khronos {
+                files::write_png(&dir.join("lut_ggx.png"), lut.size, lut.size, &files::lut_preview(lut))?;
+                add("lut_ggx.png".into(), "split-sum table, height-correlated Smith: R = A, G = B (8-bit), x = n.v, y = roughness", None, None);
+            } else {
+                ktx2::write_table(&dir.join("dfg.ktx2"), lut, sc)?;
+                add(
+                    "dfg.ktx2".into(),
+                    "split-sum table, height-correlated Smith, R16G16_SFLOAT: R = A, G = B, x = n.v, y = perceptual roughness (Bevy's DfgLut)",
+                    None,
+                    None,
+                );
+            }
+        }
+        Target::Filament => {
+            let sh = baked.sh9.as_ref().ok_or_else(|| missing("SH9 coefficients"))?;
+            let c = sh9_polynomial(&sh.as_vec4());
+            let metadata: String = c.iter().map(|v| format!("{} {} {}\n", v.x, v.y, v.z)).collect();
+            const NAMES: [&str; SH9] = ["L00", "L1-1", "L10", "L11", "L2-2", "L2-1", "L20", "L21", "L22"];
+            let text: String =
+                c.iter().zip(NAMES).map(|(v, n)| format!("({:18.15}, {:18.15}, {:18.15}); // {n}, irradiance, pre-scaled base\n", v.x, v.y, v.z)).collect();
+            let spec = baked.specular.as_ref().ok_or_else(|| missing("specular cube"))?;
+            let ibl = format!("{name}_ibl.ktx");
+            let w = ktx1::write(&dir.join(&ibl), spec, &[("sh", &metadata)])?;
+            report_clamp_ktx1(&ibl, &w);
+            add(
+                ibl,
+                "GGX-prefiltered radiance (KTX 1.1, R11F_G11F_B10F), mip m at perceptual roughness 1 - sqrt(1 - m/(mips-1)); 'sh' metadata: E/pi SH for the shader",
+                None,
+                Some(w),
+            );
+            let sky = Cube { layout: splitsum_shaders::cubemap::CubeLayout::new(baked.source.layout.size, 1), texels: baked.source.level(0).to_vec() };
+            let skybox = format!("{name}_skybox.ktx");
+            let w = ktx1::write(&dir.join(&skybox), &sky, &[])?;
+            report_clamp_ktx1(&skybox, &w);
+            add(skybox, "the environment as a cube (KTX 1.1, R11F_G11F_B10F)", None, Some(w));
+            files::write_atomic(&dir.join("sh.txt"), |w| std::io::Write::write_all(w, text.as_bytes()))?;
+            add("sh.txt".into(), "E/pi as 9 RGB coefficients of 1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2 (cmgen --sh-shader)", None, None);
+        }
+    }
+    Ok(out)
+}
+
+/// The conventions of `target`'s files, stated in its manifest.
+pub fn target_conventions(target: Target) -> &'static [&'static str] {
+    match target {
+        Target::Splitsum => &CONVENTIONS,
+        Target::Khronos | Target::Bevy => &[
+            "cube faces +X -X +Y -Y +Z -Z, Vulkan/KTX2 orientation; the equirect's centre faces +X (glTF-IBL-Sampler): splitsum's (x, y, z) is this cube's (-z, y, x)",
+            "specular mip m holds perceptual roughness m/(mips-1) (alpha = roughness^2); mips = floor(log2(size)), down to 2x2",
+            "diffuse values are E/pi",
+            "BRDF table: height-correlated Smith (V_SmithGGXCorrelated), F = f0*A + B",
+            "bevy: every KTX2 Zstandard-supercompressed; Bevy samples the cube at (x, y, -z) of its world direction",
+        ],
+        Target::Filament => &[
+            "cube faces +X -X +Y -Y +Z -Z; the equirect's centre faces +Z (cmgen, mirrored by default): splitsum's (x, y, z) is this cube's (-x, y, -z)",
+            "specular mip m holds perceptual roughness 1 - sqrt(1 - m/(mips-1)); Filament reads lod = (mips-1)*r*(2-r); mips from size down to 16x16",
+            "SH: E/pi = max(0, sum c_k P_k(n)), P = 1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2 (Irradiance_SphericalHarmonics)",
+            "R11F_G11F_B10F: values above 65024 are written as 65024 and counted",
+        ],
+    }
+}
+
+fn report_clamp_ktx1(name: &str, w: &ktx1::Written) {
+    if w.clamped > 0 {
+        crate::progress::note(&format!(
+            "warning: {name}: {} values above R11F_G11F_B10F's maximum 65024 (largest {:.4e}) were written as 65024",
+            w.clamped, w.max_value
+        ));
+    }
 }
 
 fn report_clamp(name: &str, w: &ktx2::Written) {

@@ -42,9 +42,11 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let out = files::OutputDir::begin(&args.out, "--out")?;
     let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
     let backend = Backend::open(args.backend)?;
-    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::ALL, &settings.all_levels()), args.scene.force)?;
-    println!("baking {} on {}", env_path.display(), backend.describe());
-    let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
+    // An engine target bakes only what its engine reads.
+    let products = settings.target.products();
+    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, products, &settings.all_levels()), args.scene.force)?;
+    println!("baking {} on {} for {}", env_path.display(), backend.describe(), settings.target.name());
+    let baked = bake::bake(&backend, &env, &settings, products)?;
     let manifest = output::Manifest {
         environment: env_path.display().to_string(),
         backend: backend.describe(),
@@ -58,7 +60,8 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
         files: Vec::new(),
         conventions: output::CONVENTIONS.to_vec(),
     };
-    let manifest = output::write(out.path(), &baked, &settings, manifest)?;
+    let name = out.target().file_name().map_or_else(|| "ibl".into(), |n| n.to_string_lossy().into_owned());
+    let manifest = output::write(out.path(), &name, &baked, &settings, manifest)?;
     out.commit()?;
     for t in &manifest.timings {
         println!("  {:<12} {:>9.3} s", t.product, t.seconds);
