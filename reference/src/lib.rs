@@ -250,7 +250,7 @@ pub struct Environment {
 
 /// The direction through face coordinates `(a, b)` ∈ [−1, 1]² of `face` (OpenGL 4.6
 /// §8.13, major axis, s_c, t_c, inverted by hand).
-fn face_dir(face: u32, a: f64, b: f64) -> [f64; 3] {
+pub fn face_dir(face: u32, a: f64, b: f64) -> [f64; 3] {
     normalize(match face {
         0 => [1.0, -b, -a],
         1 => [-1.0, -b, a],
