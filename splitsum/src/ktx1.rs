@@ -43,16 +43,7 @@ pub struct Written {
 pub fn encode(cube: &Cube, metadata: &[(&str, &str)]) -> (Vec<u8>, Written) {
     let layout = cube.layout;
     let mut written = Written::default();
-    let mut kvd = Vec::new();
-    for (key, value) in metadata {
-        let len = key.len() + 1 + value.len() + 1;
-        kvd.extend_from_slice(&(len as u32).to_le_bytes());
-        kvd.extend_from_slice(key.as_bytes());
-        kvd.push(0);
-        kvd.extend_from_slice(value.as_bytes());
-        kvd.push(0);
-        kvd.resize(kvd.len().div_ceil(4) * 4, 0);
-    }
+    let kvd: Vec<u8> = metadata.iter().flat_map(|(key, value)| crate::ktx2::kv(key, value)).collect();
     let header = [0x0403_0201, GL_R11F_G11F_B10F, 1, GL_RGB, GL_R11F_G11F_B10F, GL_RGB, layout.size, layout.size, 0, 0, 6, layout.levels, kvd.len() as u32];
     let mut out = IDENTIFIER.to_vec();
     for v in header {

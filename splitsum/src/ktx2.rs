@@ -83,7 +83,9 @@ fn dfd(format: ::ktx2::Format, supercompressed: bool) -> (Vec<u8>, u32) {
     (d, type_size)
 }
 
-fn kv(key: &str, value: &str) -> Vec<u8> {
+/// One key/value entry (`keyAndValueByteSize`, `key\0value\0`, padded to 4 bytes): the
+/// same in KTX2 (§3.11) and KTX 1.1.
+pub(crate) fn kv(key: &str, value: &str) -> Vec<u8> {
     let mut entry = Vec::new();
     let len = key.len() + 1 + value.len() + 1;
     entry.extend_from_slice(&(len as u32).to_le_bytes());
