@@ -640,3 +640,33 @@ fn khronos_target_matches_gltf_ibl_sampler() {
     println!("mips 1-{}: mean error splitsum {:.3} %, glTF-IBL-Sampler {:.3} %", mips - 1, 100.0 * es, 100.0 * ek);
     assert!(es < ek, "splitsum's error {es} is not below glTF-IBL-Sampler's {ek}");
 }
+
+/// Six faces are taken as they are, except where the engine's baker mirrors them: cmgen
+/// mirrors every input in `x` (`mirrorCubemap`, on by default), so the filament target
+/// moves a bright texel of `+X` to the mirrored texel of `−X`; khronos
+/// (glTF-IBL-Sampler's `-inputIsCubeMap`) and splitsum leave it.
+#[test]
+fn six_faces_are_mirrored_only_for_filament() {
+    let d = scratch("faces");
+    let faces = d.join("faces");
+    std::fs::create_dir_all(&faces).unwrap();
+    let s = 32u32;
+    let (bx, by) = (5u32, 9u32);
+    for (k, name) in ["px", "nx", "py", "ny", "pz", "nz"].iter().enumerate() {
+        write_hdr(&faces.join(format!("{name}.hdr")), s, s, |u, v| if k == 0 && (u * s as f64) as u32 == bx && (v * s as f64) as u32 == by { [5000.0; 3] } else { [0.01; 3] });
+    }
+    let lit = reference::texel_dir(0, bx, by, s);
+    let mirrored = [-lit[0], lit[1], lit[2]];
+    let near = 0.5 * 2.0 / s as f64;
+    let small = ["--backend", "cpu", "--size", "32", "--irradiance-size", "8", "--lut-size", "16"];
+    let k = d.join("khronos");
+    bake(&faces, &k, "khronos", &small);
+    let got = brightest(&read_ktx2(&k.join("ggx/specular.ktx2")).levels[0], s);
+    assert!(angle(got, lit) < near, "khronos keeps the faces: peak at {got:?}, the texel at {lit:?}");
+    let f = d.join("filament");
+    bake(&faces, &f, "filament", &small);
+    for name in ["filament_ibl.ktx", "filament_skybox.ktx"] {
+        let got = brightest(&read_ktx1(&f.join(name)).levels[0], s);
+        assert!(angle(got, mirrored) < near, "{name}: peak at {got:?}, cmgen's mirror at {mirrored:?}");
+    }
+}

@@ -143,6 +143,23 @@ pub fn texel_dir(face: u32, x: u32, y: u32, size: u32) -> Vec3 {
     face_uv_to_dir(face, Vec2::new((x as f32 + 0.5) / s, (y as f32 + 0.5) / s))
 }
 
+/// The texel `(face, x, y)` of a `size`² cube that holds direction `(−x, y, z)` of texel
+/// `(face, x, y)`: the cube mirrored in `x`, which Filament's cmgen applies to every input
+/// by default (`CubemapUtils::mirrorCubemap`, undone by `--no-mirror`). An exact texel
+/// permutation: `+X` and `−X` swap and every face's columns reverse (the `sc` of the
+/// OpenGL face table changes sign with `x` on every face).
+#[inline]
+pub fn mirrored_x_texel(face: u32, x: u32, y: u32, size: u32) -> (u32, u32, u32) {
+    let f = if face == 0 {
+        1
+    } else if face == 1 {
+        0
+    } else {
+        face
+    };
+    (f, size - 1 - x, y)
+}
+
 /// Solid angle subtended at the origin by triangle `a, b, c` on the plane `z = 1`, whose
 /// triple product `a·(b×c)` is `triple` (Van Oosterom & Strackee 1983).
 #[inline]

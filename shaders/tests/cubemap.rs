@@ -185,3 +185,22 @@ fn facings_turn_the_image_centre_about_up() {
         assert_eq!(Facing::from_u32(f.code()), f);
     }
 }
+
+/// `mirrored_x_texel` is the texel whose centre is the mirror `(−x, y, z)` of the given
+/// texel's centre, on every face, and an involution.
+#[test]
+fn mirrored_x_texel_mirrors_the_texel_centre() {
+    for s in [1u32, 2, 5, 8] {
+        for face in 0..6 {
+            for y in 0..s {
+                for x in 0..s {
+                    let d = reference::texel_dir(face, x, y, s);
+                    let (f, mx, my) = cubemap::mirrored_x_texel(face, x, y, s);
+                    let m = reference::texel_dir(f, mx, my, s);
+                    assert!((m[0] + d[0]).abs() < 1e-12 && (m[1] - d[1]).abs() < 1e-12 && (m[2] - d[2]).abs() < 1e-12, "face {face} ({x}, {y}) of {s}");
+                    assert_eq!(cubemap::mirrored_x_texel(f, mx, my, s), (face, x, y));
+                }
+            }
+        }
+    }
+}

@@ -11,7 +11,7 @@ use crate::error::{Error, Result};
 use crate::settings::{Products, Settings, TableMethod, exact_levels, level_of_size};
 use crate::texture::{Cube, Lut, Sh9};
 use serde::Serialize;
-use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::cubemap::{self, CubeLayout};
 use splitsum_shaders::equirect;
 use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::shade::EnvironmentShape;
@@ -108,8 +108,19 @@ pub fn source_cube<K: Kernels>(k: &K, env: &Environment, settings: &Settings) ->
             Ok((k.equirect_to_cube(e, size, n, settings.facing)?, layout))
         }
         Environment::Cube(c) => {
-            let full_layout = CubeLayout::new(c.layout.size, CubeLayout::full_chain(c.layout.size));
-            let mut texels = c.texels.clone();
+            let s = c.layout.size;
+            let full_layout = CubeLayout::new(s, CubeLayout::full_chain(s));
+            let mut texels = if settings.target.fixed().mirror_faces {
+                // The faces as the target's baker reads them: mirrored in x (a permutation).
+                (0..6 * s * s)
+                    .map(|k| {
+                        let (f, x, y) = cubemap::mirrored_x_texel(k / (s * s), k % s, (k / s) % s, s);
+                        c.texels[c.layout.index(0, f, x, y) as usize]
+                    })
+                    .collect()
+            } else {
+                c.texels.clone()
+            };
             texels.resize(full_layout.texel_count() as usize, Default::default());
             cube_source(k, k.upload("cube faces", &texels)?, c.layout.size, settings)
         }

@@ -65,23 +65,33 @@ pub struct Fixed {
     pub mips: Option<fn(u32) -> u32>,
     /// The table's masking term (where the target has a table).
     pub lut_masking: Option<Masking>,
+    /// A cube input (six faces) is mirrored in `x` (`cubemap::mirrored_x_texel`), as cmgen
+    /// mirrors every input; equirects are covered by `facing`.
+    pub mirror_faces: bool,
 }
 
 impl Target {
     /// The settings this target fixes, with where each comes from.
     pub fn fixed(self) -> Fixed {
         match self {
-            Target::Splitsum => Fixed { facing: Facing::NegZ, mapping: None, mips: None, lut_masking: None },
+            Target::Splitsum => Fixed { facing: Facing::NegZ, mapping: None, mips: None, lut_masking: None, mirror_faces: false },
             // glTF-IBL-Sampler `lib.cpp`: `_mipmapCount = floor(log2(_cubemapResolution))`,
             // `roughness = currentMipLevel / (outputMipLevels - 1)`; its table uses
             // `V_SmithGGXCorrelated` (`filter.frag`). Bevy reads mip
             // `perceptual_roughness * (levels - 1)` (`environment_map.wesl`).
-            Target::Khronos | Target::Bevy => {
-                Fixed { facing: Facing::PosX, mapping: Some(RoughnessMapping::Linear), mips: Some(khronos_mips), lut_masking: Some(Masking::SmithCorrelated) }
-            }
+            Target::Khronos | Target::Bevy => Fixed {
+                facing: Facing::PosX,
+                mapping: Some(RoughnessMapping::Linear),
+                mips: Some(khronos_mips),
+                lut_masking: Some(Masking::SmithCorrelated),
+                mirror_faces: false,
+            },
             // cmgen: levels from the base size down to 16² (`IBL_DEFAULT_MIN_LOD_SIZE`),
-            // `lodToPerceptualRoughness`; Filament's engine carries its own DFG table.
-            Target::Filament => Fixed { facing: Facing::PosZ, mapping: Some(RoughnessMapping::Filament), mips: Some(filament_mips), lut_masking: None },
+            // `lodToPerceptualRoughness`, every input mirrored (`g_mirror`); Filament's
+            // engine carries its own DFG table.
+            Target::Filament => {
+                Fixed { facing: Facing::PosZ, mapping: Some(RoughnessMapping::Filament), mips: Some(filament_mips), lut_masking: None, mirror_faces: true }
+            }
         }
     }
 

@@ -19,6 +19,7 @@ use crate::environment::Environment;
 use crate::error::{Error, Result};
 use crate::settings::{Products, Settings};
 use crate::texture::{Cube, Equirect};
+use splitsum_shaders::choice::Choice;
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::half::{clean_radiance, copied_texel, f16_bits_to_f32, pack_radiance};
@@ -365,6 +366,13 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) ->
                 CubeLayout::new(source_size, CubeLayout::full_chain(source_size)),
             ))
         }
+        Shape::Cube if settings.target.fixed().mirror_faces => Err(Error::setting(
+            "target",
+            format!(
+                "{}: a cube texture is not mirrored on the device; pass its faces as host data (Source::Environment) or an equirect",
+                settings.target.name()
+            ),
+        )),
         Shape::Cube => bake::cube_source(g, texels, size.width, settings),
     }
 }
