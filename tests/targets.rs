@@ -653,7 +653,9 @@ fn six_faces_are_mirrored_only_for_filament() {
     let s = 32u32;
     let (bx, by) = (5u32, 9u32);
     for (k, name) in ["px", "nx", "py", "ny", "pz", "nz"].iter().enumerate() {
-        write_hdr(&faces.join(format!("{name}.hdr")), s, s, |u, v| if k == 0 && (u * s as f64) as u32 == bx && (v * s as f64) as u32 == by { [5000.0; 3] } else { [0.01; 3] });
+        write_hdr(&faces.join(format!("{name}.hdr")), s, s, |u, v| {
+            if k == 0 && (u * s as f64) as u32 == bx && (v * s as f64) as u32 == by { [5000.0; 3] } else { [0.01; 3] }
+        });
     }
     let lit = reference::texel_dir(0, bx, by, s);
     let mirrored = [-lit[0], lit[1], lit[2]];

@@ -75,7 +75,7 @@ pub fn environment(name: &str) -> splitsum::texture::Equirect {
 pub fn source_cube(name: &str, size: u32) -> splitsum::texture::Cube {
     let e = environment(name);
     let n = splitsum_shaders::equirect::supersampling(size, e.width, 2.0);
-    Backend::Cpu.equirect_to_cube(&e, size, n).expect("cpu bake")
+    Backend::Cpu.equirect_to_cube(&e, size, n, splitsum_shaders::equirect::Facing::NegZ).expect("cpu bake")
 }
 
 /// A small, quick bake of the courtyard for the display tests (32² specular cube with 4

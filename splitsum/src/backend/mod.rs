@@ -111,10 +111,10 @@ impl Backend {
     }
 
     /// The source cube: `env` resampled to faces of `size` with `supersample`² points per
-    /// texel (facing splitsum's way, `Facing::NegZ`), and its full mip chain.
-    pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32) -> Result<Cube> {
+    /// texel, the image centre facing `facing`, and its full mip chain.
+    pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Cube> {
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
-        with_kernels!(self, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, Facing::NegZ)?)? }))
+        with_kernels!(self, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, facing)?)? }))
     }
 
     /// Fills levels 1.. of `cube` from its level 0.
