@@ -80,6 +80,7 @@ fn read_ktx2(path: &Path) -> Ktx2 {
         Some(ktx2::Format::R16G16B16A16_SFLOAT) => (4, true),
         Some(ktx2::Format::R32G32B32A32_SFLOAT) => (4, false),
         Some(ktx2::Format::R16G16_SFLOAT) => (2, true),
+        Some(ktx2::Format::E5B9G9R9_UFLOAT_PACK32) => (0, false),
         f => panic!("{}: unexpected format {f:?}", path.display()),
     };
     let levels = r
@@ -93,6 +94,17 @@ fn read_ktx2(path: &Path) -> Ktx2 {
             } else {
                 level.data.to_vec()
             };
+            if channels == 0 {
+                // RGB9_E5: three 9-bit mantissas and the exponent, value m·2^(e − 15 − 9).
+                return data
+                    .chunks_exact(4)
+                    .map(|b| {
+                        let v = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+                        let s = 2f32.powi((v >> 27) as i32 - 24);
+                        [(v & 511) as f32 * s, ((v >> 9) & 511) as f32 * s, ((v >> 18) & 511) as f32 * s, 1.0]
+                    })
+                    .collect();
+            }
             let values: Vec<f32> = if f16 {
                 data.chunks_exact(2).map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32()).collect()
             } else {
@@ -239,6 +251,15 @@ fn white_furnace_through_each_engines_formula() {
         assert!(f.zstd, "{name}: Bevy's environment maps are Zstandard-supercompressed");
         for level in &f.levels {
             check(level, 1.0 / 1024.0, &format!("bevy {name}"));
+        }
+    }
+    // Bevy's own maps are RGB9_E5 (`pisa_*_rgb9e5_zstd.ktx2`): 0.5, 1 and 2 share the
+    // exponent of 2 and are whole steps of 2⁻⁷, so exact.
+    let b9 = d.join("bevy9e5");
+    bake(&env, &b9, "bevy", &[&small[..], &["--format", "rgb9e5"]].concat());
+    for name in ["specular.ktx2", "diffuse.ktx2"] {
+        for level in &read_ktx2(&b9.join(name)).levels {
+            check(level, 0.0, &format!("bevy rgb9e5 {name}"));
         }
     }
     let dfg = read_ktx2(&b.join("dfg.ktx2"));
@@ -434,7 +455,14 @@ fn every_ktx_file_loads_in_libktx() {
     let env = d.join("sky.hdr");
     write_hdr(&env, 128, 64, |u, v| [1.0 + 10.0 * u, 0.5 + v, 70000.0 * (u > 0.5 && v < 0.1) as u8 as f64 + 0.2]);
     let mut checked = 0;
-    for (target, extra) in [("splitsum", &["--format", "rgba16f"][..]), ("splitsum", &[][..]), ("khronos", &[][..]), ("bevy", &[][..]), ("filament", &[][..])] {
+    for (target, extra) in [
+        ("splitsum", &["--format", "rgba16f"][..]),
+        ("splitsum", &[][..]),
+        ("khronos", &[][..]),
+        ("bevy", &[][..]),
+        ("bevy", &["--format", "rgb9e5"][..]),
+        ("filament", &[][..]),
+    ] {
         let out = d.join(format!("{target}{}", extra.len()));
         let mut args = vec!["--backend", "cpu", "--size", "32", "--irradiance-size", "8", "--lut-size", "16"];
         args.extend_from_slice(extra);
@@ -493,8 +521,8 @@ fn every_ktx_file_loads_in_libktx() {
             }
         }
     }
-    // splitsum ×2 (specular, irradiance), khronos 2, bevy 3, filament 2.
-    assert_eq!(checked, 11, "KTX files checked");
+    // splitsum ×2 (specular, irradiance), khronos 2, bevy 3 (and 3 in RGB9_E5), filament 2.
+    assert_eq!(checked, 14, "KTX files checked");
 }
 
 /// The khronos target against glTF-IBL-Sampler itself, on the same `.hdr`: the same face

@@ -8,6 +8,7 @@
 //! out of the mantissa moves into the exponent, which is the correctly rounded result
 //! (up to +∞ past 65504). [`pack_radiance`] clamps first, so radiance never reaches ∞.
 
+use crate::math;
 use spirv_std::glam::Vec4;
 
 /// The largest finite half float.
@@ -111,6 +112,49 @@ pub const UFLOAT11_MAX: f32 = 65024.0;
 #[inline]
 pub fn pack_r11g11b10f(r: f32, g: f32, b: f32) -> u32 {
     f32_to_unsigned_small_float(r, 6) | (f32_to_unsigned_small_float(g, 6) << 11) | (f32_to_unsigned_small_float(b, 5) << 22)
+}
+
+/// The largest value of `RGB9_E5`: `(2⁹ − 1)/2⁹ · 2¹⁶`.
+pub const RGB9E5_MAX: f32 = 65408.0;
+
+/// `2ᵏ` for `−126 ≤ k ≤ 127`, exactly, from its bits.
+#[inline]
+fn pow2(k: i32) -> f32 {
+    f32::from_bits(((k + 127) as u32) << 23)
+}
+
+/// An RGB value packed as `RGB9_E5` (`E5B9G9R9_UFLOAT_PACK32`: red in bits 0–8, green
+/// 9–17, blue 18–26, the shared exponent in 27–31), by the encoding of
+/// `EXT_texture_shared_exponent` (§"Shared exponent encoding"; OpenGL 4.6 §8.5.2): each
+/// channel clamped to `[0, RGB9E5_MAX]` (NaN to 0), the exponent `max(−16,
+/// ⌊log₂ max⌋) + 16` (raised by one where the largest mantissa rounds up to 2⁹), each
+/// mantissa `⌊c / 2^(e − 24) + ½⌋`. `⌊log₂⌋` is read from the f32 exponent bits and the
+/// powers of two are built from bits, so both backends agree bit for bit.
+#[inline]
+pub fn pack_rgb9e5(r: f32, g: f32, b: f32) -> u32 {
+    #[allow(clippy::eq_op)]
+    let c = |x: f32| {
+        if x != x || x <= 0.0 {
+            0.0
+        } else if x > RGB9E5_MAX {
+            RGB9E5_MAX
+        } else {
+            x
+        }
+    };
+    let (r, g, b) = (c(r), c(g), c(b));
+    let m = if r > g { r } else { g };
+    let m = if m > b { m } else { b };
+    // ⌊log₂ m⌋ for normal m; zero and subnormals are below 2⁻¹⁶ and take the floor −16.
+    let floor_log2 = ((m.to_bits() >> 23) & 0xff) as i32 - 127;
+    let mut e = if floor_log2 < -16 { -16 } else { floor_log2 } + 16;
+    let maxm = math::floor(m * pow2(24 - e) + 0.5) as u32;
+    if maxm == 512 {
+        e += 1;
+    }
+    let scale = pow2(24 - e);
+    let q = |x: f32| math::floor(x * scale + 0.5) as u32;
+    q(r) | (q(g) << 9) | (q(b) << 18) | ((e as u32) << 27)
 }
 
 /// Two radiance values packed as halves (`a` in the low 16 bits): NaN becomes 0 and

@@ -91,3 +91,46 @@ fn unsigned_small_floats_round_to_nearest_even_and_never_overflow() {
     assert_eq!(pack_r11g11b10f(0.0, 1.0, 0.0), (15 << 6) << 11);
     assert_eq!(pack_r11g11b10f(0.0, 0.0, 1.0), (15 << 5) << 22);
 }
+
+/// `RGB9_E5` written here from `EXT_texture_shared_exponent` in f64 (with `log2`, `powi`),
+/// independently of the packer's bit tricks.
+fn rgb9e5_spec(c: [f32; 3]) -> u32 {
+    let max = 511.0 / 512.0 * 65536.0;
+    let c = c.map(|x| if x.is_nan() { 0.0 } else { (x as f64).clamp(0.0, max) });
+    let m = c[0].max(c[1]).max(c[2]);
+    let mut e = (if m > 0.0 { m.log2().floor() } else { -16.0 }).max(-16.0) as i32 + 16;
+    if (m / 2f64.powi(e - 24) + 0.5).floor() == 512.0 {
+        e += 1;
+    }
+    let q = |x: f64| (x / 2f64.powi(e - 24) + 0.5).floor() as u32;
+    q(c[0]) | (q(c[1]) << 9) | (q(c[2]) << 18) | ((e as u32) << 27)
+}
+
+/// `pack_rgb9e5` equals the extension's encoding on colours from 2⁻²⁴ to past the
+/// maximum, at mantissa boundaries (where the shared exponent steps up) and on NaN, ∞ and
+/// negatives; and decoding gives each channel within half a step of its exponent.
+#[test]
+fn rgb9e5_packs_as_the_shared_exponent_extension_says() {
+    use splitsum_shaders::half::{RGB9E5_MAX, pack_rgb9e5};
+    let mut values = vec![0.0f32, 1.0, 0.5, 65408.0, 65500.0, 1e9, f32::INFINITY, -3.0, f32::NAN, 511.5 / 512.0, 1.0 - 1.0 / 1024.0, 1.0 - 1.0 / 2048.0];
+    let mut x = 1.7e-8f32;
+    while x < 1e6 {
+        values.push(x);
+        x *= 1.37;
+    }
+    for &r in &values {
+        for &g in &[0.0f32, 0.001, 0.75, r * 0.5, r] {
+            for &b in &[0.0f32, 3.0, r * 0.01] {
+                let got = pack_rgb9e5(r, g, b);
+                assert_eq!(got, rgb9e5_spec([r, g, b]), "({r}, {g}, {b})");
+                let e = (got >> 27) as i32;
+                for (k, c) in [r, g, b].into_iter().enumerate() {
+                    let m = (got >> (9 * k)) & 511;
+                    let back = m as f64 * 2f64.powi(e - 24);
+                    let want = if c.is_nan() { 0.0 } else { (c as f64).clamp(0.0, RGB9E5_MAX as f64) };
+                    assert!((back - want).abs() <= 0.5 * 2f64.powi(e - 24) * (1.0 + 1e-9), "({r}, {g}, {b}) channel {k}: {back} for {want}");
+                }
+            }
+        }
+    }
+}

@@ -10,12 +10,14 @@
 //!
 //! **Half-float overflow rule**: `RGBA16F` holds finite values up to 65504. Larger values
 //! are clamped to 65504 and counted; nothing becomes infinity. [`Format::Auto`] picks
-//! `RGBA16F` unless some value exceeds 65504, then `RGBA32F`.
+//! `RGBA16F` unless some value exceeds 65504, then `RGBA32F`. `RGB9E5` (opt-in: half the
+//! size, but each channel keeps only 9 bits below the brightest of the three, so a
+//! saturated colour's dim channels lose most of theirs) clamps at 65408 the same way.
 
 use crate::error::Result;
 use crate::files::write_atomic;
 use crate::texture::{Cube, Lut};
-use splitsum_shaders::half::f32_to_f16_bits;
+use splitsum_shaders::half::{f32_to_f16_bits, pack_rgb9e5};
 use std::io::Write;
 use std::path::Path;
 
@@ -23,7 +25,9 @@ use std::path::Path;
 pub const VK_FORMAT_R16G16B16A16_SFLOAT: u32 = 97;
 /// `VK_FORMAT_R32G32B32A32_SFLOAT`.
 pub const VK_FORMAT_R32G32B32A32_SFLOAT: u32 = 109;
-pub use splitsum_shaders::half::HALF_MAX;
+/// `VK_FORMAT_E5B9G9R9_UFLOAT_PACK32`.
+pub const VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: u32 = 123;
+pub use splitsum_shaders::half::{HALF_MAX, RGB9E5_MAX};
 
 /// Texel format of a written cube.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -34,9 +38,13 @@ pub enum Format {
     Rgba16f,
     /// Single floats.
     Rgba32f,
+    /// `E5B9G9R9_UFLOAT_PACK32`: four bytes a texel, RGB with a shared exponent (9-bit
+    /// mantissas; Bevy's own environment maps), no alpha; values above 65408 are clamped
+    /// (and counted).
+    Rgb9e5,
 }
 
-splitsum_shaders::choice!(Format: Auto => "auto", Rgba16f => "rgba16f", Rgba32f => "rgba32f");
+splitsum_shaders::choice!(Format: Auto => "auto", Rgba16f => "rgba16f", Rgba32f => "rgba32f", Rgb9e5 => "rgb9e5");
 
 /// What writing a cube did to its values.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -71,10 +79,13 @@ fn round_up(x: usize, to: usize) -> usize {
 /// The data format descriptor of `format` (`dfdTotalSize`, then the basic block the
 /// `ktx2` crate builds from the format's description, as libktx's `createDFDUnpacked`
 /// does), and the header's `typeSize`. A supercompressed file's descriptor has
-/// `bytesPlane0 = 0` (§3.10.2: its levels are "unsized").
+/// `bytesPlane0 = 0` (§3.10.2: its levels are "unsized"), except for the packed
+/// shared-exponent `E5B9G9R9`, whose texel size libktx cannot rebuild from its samples (it
+/// refuses such a file, "Texture type not supported"); it keeps 4, as Bevy's own
+/// `*_rgb9e5_zstd.ktx2` do.
 fn dfd(format: ::ktx2::Format, supercompressed: bool) -> (Vec<u8>, u32) {
     let (mut basic, type_size) = ::ktx2::dfd::Basic::from_format(format).expect("float formats have a descriptor");
-    if supercompressed {
+    if supercompressed && format != ::ktx2::Format::E5B9G9R9_UFLOAT_PACK32 {
         basic.bytes_planes[0] = 0;
     }
     let block = ::ktx2::dfd::Block::Basic(basic).to_vec();
@@ -119,6 +130,7 @@ pub fn encode_with(cube: &Cube, format: Format, sc: Supercompression) -> (Vec<u8
     let format = format.resolve(cube);
     let kformat = match format {
         Format::Rgba32f => ::ktx2::Format::R32G32B32A32_SFLOAT,
+        Format::Rgb9e5 => ::ktx2::Format::E5B9G9R9_UFLOAT_PACK32,
         _ => ::ktx2::Format::R16G16B16A16_SFLOAT,
     };
     let mut written = Written { vk_format: kformat.value(), clamped: 0, max_value: max_value(cube) };
@@ -126,6 +138,11 @@ pub fn encode_with(cube: &Cube, format: Format, sc: Supercompression) -> (Vec<u8
         .map(|level| {
             let mut p = Vec::new();
             for t in cube.level(level) {
+                if format == Format::Rgb9e5 {
+                    written.clamped += [t.x, t.y, t.z].iter().filter(|&&v| v > RGB9E5_MAX).count() as u64;
+                    p.extend_from_slice(&pack_rgb9e5(t.x, t.y, t.z).to_le_bytes());
+                    continue;
+                }
                 for v in [t.x, t.y, t.z, t.w] {
                     if format == Format::Rgba32f {
                         p.extend_from_slice(&v.to_le_bytes());

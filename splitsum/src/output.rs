@@ -316,8 +316,9 @@ fn report_clamp_ktx1(name: &str, w: &ktx1::Written) {
 
 fn report_clamp(name: &str, w: &ktx2::Written) {
     if w.clamped > 0 {
+        let (format, max) = if w.vk_format == ktx2::VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 { ("RGB9E5", ktx2::RGB9E5_MAX) } else { ("half-float", ktx2::HALF_MAX) };
         crate::progress::note(&format!(
-            "warning: {name}: {} values above the half-float maximum 65504 (largest {:.4e}) were clamped to 65504; the rgba32f format keeps them",
+            "warning: {name}: {} values above the {format} maximum {max} (largest {:.4e}) were clamped to {max}; the rgba32f format keeps them",
             w.clamped, w.max_value
         ));
     } else if w.vk_format == ktx2::VK_FORMAT_R32G32B32A32_SFLOAT && w.max_value > ktx2::HALF_MAX {
