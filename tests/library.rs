@@ -175,3 +175,31 @@ fn the_library_says_what_is_wrong_in_its_own_terms() {
     let e = baker.bake(Source::Texture(&odd), &small()).err().expect("not an equirect").to_string();
     assert!(e.contains("30×20") && e.contains("equirect"), "{e}");
 }
+
+/// The library takes the engine target the CLI does: `Settings::with_target` on the
+/// caller's device gives the glTF-IBL-Sampler's mip count and roughness per mip, and a
+/// bright texel lands where that sampler puts it (`filter.frag` `dirToUV`: `u = ½ +
+/// atan2(z, x)/2π`), on the GPU and the CPU alike.
+#[test]
+fn the_baker_takes_an_engine_target() {
+    let (d, q) = device();
+    let (w, h, px, py) = (128usize, 64usize, 20usize, 25usize);
+    let mut texels = vec![Vec4::new(0.01, 0.01, 0.01, 1.0); w * h];
+    texels[py * w + px] = Vec4::new(5000.0, 5000.0, 5000.0, 1.0);
+    let env = Environment::Equirect(Equirect { width: w as u32, height: h as u32, texels });
+    let s = Settings { size: 32, source_size: 32, irradiance_size: 8, lut_size: 32, ..Settings::default() }.with_target(splitsum::Target::Khronos);
+    assert_eq!((s.mips, s.roughness()[1]), (5, 0.25), "floor(log2 32) mips at m/(M - 1)");
+    let (u, v) = ((px as f64 + 0.5) / w as f64, (py as f64 + 0.5) / h as f64);
+    let (phi, theta) = (std::f64::consts::TAU * (u - 0.5), std::f64::consts::PI * v);
+    let want = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];
+    for compute in [Compute::Gpu, Compute::Cpu] {
+        let data = Baker::new(d, q, compute).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
+        assert_eq!(data.specular.layout.levels, 5);
+        let level = data.specular.level(0);
+        let k = (0..level.len()).max_by(|&a, &b| level[a].x.total_cmp(&level[b].x)).unwrap() as u32;
+        let got = reference::texel_dir(k / (32 * 32), k % 32, (k / 32) % 32, 32);
+        let angle = reference::dot(got, want).clamp(-1.0, 1.0).acos();
+        // Within one and a half texels of the 32² face (a texel spans about 2/32 rad).
+        assert!(angle < 1.5 * 2.0 / 32.0, "{compute:?}: peak at {got:?}, glTF-IBL-Sampler's at {want:?}");
+    }
+}
