@@ -232,7 +232,7 @@ impl Baked {
     /// What a renderer reads, with stand-ins for the products not baked (nothing reads
     /// them) and the source cube's level 0 (the sharp sky).
     pub fn into_display(self, mapping: RoughnessMapping) -> BakedEnvironment {
-        let source = Cube { layout: CubeLayout::new(self.source.layout.size, 1), texels: self.source.level(0).to_vec() };
+        let source = self.source.levels(0, 0);
         BakedEnvironment {
             source,
             specular: self.specular.unwrap_or_else(empty_cube),

@@ -182,7 +182,7 @@ impl Cache {
         let mut files = BTreeMap::new();
         let mut lut = env.lut.size.to_le_bytes().to_vec();
         lut.extend_from_slice(bytemuck::cast_slice(&env.lut.texels));
-        let source = Cube { layout: CubeLayout::new(env.source.layout.size, 1), texels: env.source.level(0).to_vec() };
+        let source = env.source.levels(0, 0);
         for (name, bytes) in [
             ("source.bin", cube_bytes(&source)),
             ("specular.bin", cube_bytes(&env.specular)),
