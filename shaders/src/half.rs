@@ -106,6 +106,10 @@ pub fn f32_to_unsigned_small_float(x: f32, mantissa: u32) -> u32 {
 /// The largest value of an 11-bit unsigned float (6-bit mantissa): `2¹⁵·(2 − 2⁻⁶)`.
 pub const UFLOAT11_MAX: f32 = 65024.0;
 
+/// The largest value of a 10-bit unsigned float (5-bit mantissa, the blue of
+/// `R11F_G11F_B10F`): `2¹⁵·(2 − 2⁻⁵)`.
+pub const UFLOAT10_MAX: f32 = 64512.0;
+
 /// An RGB value packed as `R11F_G11F_B10F` (`GL_UNSIGNED_INT_10F_11F_11F_REV`: red in
 /// bits 0–10, green 11–21, blue 22–31), each channel by [`f32_to_unsigned_small_float`]:
 /// negative and NaN channels become 0, channels past the format's range its largest value.

@@ -66,7 +66,7 @@ fn small_float_value(bits: u32, m: u32) -> f64 {
 /// NaN, negatives, overflow and ∞ give 0, 0, the largest value and the largest value.
 #[test]
 fn unsigned_small_floats_round_to_nearest_even_and_never_overflow() {
-    use splitsum_shaders::half::{UFLOAT11_MAX, f32_to_unsigned_small_float as enc, pack_r11g11b10f};
+    use splitsum_shaders::half::{UFLOAT10_MAX, UFLOAT11_MAX, f32_to_unsigned_small_float as enc, pack_r11g11b10f};
     for m in [6u32, 5] {
         let max_code = (30u32 << m) | ((1 << m) - 1);
         for c in 0..max_code {
@@ -86,6 +86,7 @@ fn unsigned_small_floats_round_to_nearest_even_and_never_overflow() {
         }
     }
     assert_eq!(small_float_value((30 << 6) | 63, 6), UFLOAT11_MAX as f64);
+    assert_eq!(small_float_value((30 << 5) | 31, 5), UFLOAT10_MAX as f64);
     // 1.0: exponent 15, mantissa 0 in each channel; red in bits 0–10, blue in 22–31.
     assert_eq!(pack_r11g11b10f(1.0, 0.0, 0.0), 15 << 6);
     assert_eq!(pack_r11g11b10f(0.0, 1.0, 0.0), (15 << 6) << 11);

@@ -12,13 +12,16 @@
 //! Filament's `toPixelDataType` maps only that `glType` (not the standard
 //! `GL_UNSIGNED_INT_10F_11F_11F_REV`) to `UINT_10F_11F_11F_REV`.
 //!
-//! **Overflow rule**: the format's largest value is 65024 (`half::UFLOAT11_MAX`, blue
-//! 64512); larger values are written as it and counted, negative values as 0.
+//! **Overflow rule**: the format's largest value is 65024 (`half::UFLOAT11_MAX`; blue
+//! 64512, `half::UFLOAT10_MAX`); larger values are written as that value and counted (in
+//! `ktx2::Written`, as `VK_FORMAT_B10G11R11_UFLOAT_PACK32`, the same texel), negative
+//! values as 0.
 
 use crate::error::Result;
 use crate::files::write_atomic;
+use crate::ktx2::{VK_FORMAT_B10G11R11_UFLOAT_PACK32, Written};
 use crate::texture::Cube;
-use splitsum_shaders::half::{UFLOAT11_MAX, pack_r11g11b10f};
+use splitsum_shaders::half::{UFLOAT10_MAX, UFLOAT11_MAX, pack_r11g11b10f};
 use std::io::Write;
 use std::path::Path;
 
@@ -29,20 +32,11 @@ pub const GL_R11F_G11F_B10F: u32 = 0x8C3A;
 /// `GL_RGB`.
 pub const GL_RGB: u32 = 0x1907;
 
-/// What writing a cube did to its values.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
-pub struct Written {
-    /// Channel values above the format's range, written as its largest value.
-    pub clamped: u64,
-    /// The largest value in the cube.
-    pub max_value: f32,
-}
-
 /// Encodes `cube` (every level) as a KTX 1.1 `R11F_G11F_B10F` cube map with `metadata`
 /// key/value pairs.
 pub fn encode(cube: &Cube, metadata: &[(&str, &str)]) -> (Vec<u8>, Written) {
     let layout = cube.layout;
-    let mut written = Written::default();
+    let mut written = Written { vk_format: VK_FORMAT_B10G11R11_UFLOAT_PACK32, clamped: 0, max_value: 0.0 };
     let kvd: Vec<u8> = metadata.iter().flat_map(|(key, value)| crate::ktx2::kv(key, value)).collect();
     let header = [0x0403_0201, GL_R11F_G11F_B10F, 1, GL_RGB, GL_R11F_G11F_B10F, GL_RGB, layout.size, layout.size, 0, 0, 6, layout.levels, kvd.len() as u32];
     let mut out = IDENTIFIER.to_vec();
@@ -54,9 +48,9 @@ pub fn encode(cube: &Cube, metadata: &[(&str, &str)]) -> (Vec<u8>, Written) {
         let s = layout.level_size(level);
         out.extend_from_slice(&(4 * s * s).to_le_bytes());
         for t in cube.level(level) {
-            for v in [t.x, t.y, t.z] {
+            for (v, max) in [(t.x, UFLOAT11_MAX), (t.y, UFLOAT11_MAX), (t.z, UFLOAT10_MAX)] {
                 written.max_value = written.max_value.max(v);
-                written.clamped += (v > UFLOAT11_MAX) as u64;
+                written.clamped += (v > max) as u64;
             }
             out.extend_from_slice(&pack_r11g11b10f(t.x, t.y, t.z).to_le_bytes());
         }

@@ -27,6 +27,9 @@ pub const VK_FORMAT_R16G16B16A16_SFLOAT: u32 = 97;
 pub const VK_FORMAT_R32G32B32A32_SFLOAT: u32 = 109;
 /// `VK_FORMAT_E5B9G9R9_UFLOAT_PACK32`.
 pub const VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: u32 = 123;
+/// `VK_FORMAT_B10G11R11_UFLOAT_PACK32`: the texel of GL's `R11F_G11F_B10F`, which the
+/// KTX 1.1 files (`crate::ktx1`) hold.
+pub const VK_FORMAT_B10G11R11_UFLOAT_PACK32: u32 = 122;
 pub use splitsum_shaders::half::{HALF_MAX, RGB9E5_MAX};
 
 /// Texel format of a written cube.
@@ -46,12 +49,12 @@ pub enum Format {
 
 splitsum_shaders::choice!(Format: Auto => "auto", Rgba16f => "rgba16f", Rgba32f => "rgba32f", Rgb9e5 => "rgb9e5");
 
-/// What writing a cube did to its values.
+/// What writing a cube did to its values (KTX2, and KTX 1.1 by its Vulkan twin format).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct Written {
     /// The format used.
     pub vk_format: u32,
-    /// Channel values clamped to 65504.
+    /// Channel values clamped to the format's largest value.
     pub clamped: u64,
     /// The largest value in the cube.
     pub max_value: f32,
@@ -181,10 +184,11 @@ fn container(kformat: ::ktx2::Format, size: u32, faces: u32, payloads: Vec<Vec<u
     let levels = payloads.len();
     let (dfd_bytes, type_size) = dfd(kformat, sc != Supercompression::None);
     // Unsupercompressed levels align to lcm(texel size, 4) (§3.9.7); supercompressed ones
-    // need none, and their descriptor's bytesPlane0 is 0 (§3.10.2, "unsized").
+    // need none (and their descriptor says "unsized", see `dfd`).
     let texel_bytes = payloads[0].len() / (faces as usize * size as usize * size as usize);
+    let raw_lengths: Vec<usize> = payloads.iter().map(Vec::len).collect();
     let (align, stored): (usize, Vec<Vec<u8>>) = match sc {
-        Supercompression::None => (if texel_bytes % 4 == 0 { texel_bytes } else { texel_bytes * 4 }, payloads.clone()),
+        Supercompression::None => (if texel_bytes % 4 == 0 { texel_bytes } else { texel_bytes * 4 }, payloads),
         Supercompression::Zstd => {
             (1, payloads.iter().map(|p| ruzstd::encoding::compress_to_vec(p.as_slice(), ruzstd::encoding::CompressionLevel::Fastest)).collect())
         }
@@ -230,7 +234,7 @@ fn container(kformat: ::ktx2::Format, size: u32, faces: u32, payloads: Vec<Vec<u
         let index = ::ktx2::LevelIndex {
             byte_offset: offsets[level] as u64,
             byte_length: stored[level].len() as u64,
-            uncompressed_byte_length: payloads[level].len() as u64,
+            uncompressed_byte_length: raw_lengths[level] as u64,
         };
         out.extend_from_slice(&index.as_bytes());
     }

@@ -15,6 +15,7 @@ use crate::settings::{Settings, Target};
 use crate::texture::{Cube, Sh9};
 use serde::Serialize;
 use splitsum_shaders::choice::Choice;
+use splitsum_shaders::half::UFLOAT11_MAX;
 use splitsum_shaders::irradiance::{SH9, SH9_COSINE, sh9_polynomial};
 use splitsum_shaders::tonemap::Tonemapper;
 use std::path::Path;
@@ -26,12 +27,9 @@ pub struct OutputFile {
     pub name: String,
     /// What it holds.
     pub what: String,
-    /// How writing it changed values (KTX2 only).
+    /// How writing it changed values (KTX2 and KTX 1.1 only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub written: Option<ktx2::Written>,
-    /// How writing it changed values (KTX 1.1 only).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub written_ktx1: Option<ktx1::Written>,
 }
 
 /// `bake.json`: what was baked, how, from what, and how long it took.
@@ -141,7 +139,7 @@ pub fn write(dir: &Path, name: &str, baked: &Baked, settings: &Settings, manifes
     }
     let mut files_out = Vec::new();
     let mut add = |name: &str, what: String, written: Option<ktx2::Written>| {
-        files_out.push(OutputFile { name: name.to_string(), what, written, written_ktx1: None });
+        files_out.push(OutputFile { name: name.to_string(), what, written });
     };
     let exposure = preview::auto_exposure(baked.source.level(0));
     let save_png = |name: &str, pic: &preview::Picture| -> Result<()> {
@@ -217,8 +215,8 @@ fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
 ///   `--format=ktx --deploy`.
 pub fn engine_files(dir: &Path, name: &str, baked: &Baked, settings: &Settings) -> Result<Vec<OutputFile>> {
     let mut out = Vec::new();
-    let mut add = |name: String, what: &str, written: Option<ktx2::Written>, written_ktx1: Option<ktx1::Written>| {
-        out.push(OutputFile { name, what: what.into(), written, written_ktx1 });
+    let mut add = |name: String, what: &str, written: Option<ktx2::Written>| {
+        out.push(OutputFile { name, what: what.into(), written });
     };
     let missing = |what: &str| crate::error::Error::Invalid(format!("the {} target needs the {what}, which was not baked", settings.target.name()));
     match settings.target {
@@ -237,21 +235,20 @@ pub fn engine_files(dir: &Path, name: &str, baked: &Baked, settings: &Settings) 
             let spec = baked.specular.as_ref().ok_or_else(|| missing("specular cube"))?;
             let w = ktx2::write_with(&dir.join(spec_name), spec, settings.format, sc)?;
             report_clamp(spec_name, &w);
-            add(spec_name.into(), "GGX-prefiltered radiance, mip m at perceptual roughness m/(mips-1)", Some(w), None);
+            add(spec_name.into(), "GGX-prefiltered radiance, mip m at perceptual roughness m/(mips-1)", Some(w));
             let irr = baked.irradiance.as_ref().ok_or_else(|| missing("irradiance cube"))?;
             let w = ktx2::write_with(&dir.join(diffuse_name), irr, settings.format, sc)?;
             report_clamp(diffuse_name, &w);
-            add(diffuse_name.into(), "irradiance divided by pi (Lambertian-filtered radiance)", Some(w), None);
+            add(diffuse_name.into(), "irradiance divided by pi (Lambertian-filtered radiance)", Some(w));
             let lut = baked.lut.as_ref().ok_or_else(|| missing("BRDF table"))?;
             if khronos {
                 files::write_png(&dir.join("lut_ggx.png"), lut.size, lut.size, &files::lut_preview(lut))?;
-                add("lut_ggx.png".into(), "split-sum table, height-correlated Smith: R = A, G = B (8-bit), x = n.v, y = roughness", None, None);
+                add("lut_ggx.png".into(), "split-sum table, height-correlated Smith: R = A, G = B (8-bit), x = n.v, y = roughness", None);
             } else {
                 ktx2::write_table(&dir.join("dfg.ktx2"), lut, sc)?;
                 add(
                     "dfg.ktx2".into(),
                     "split-sum table, height-correlated Smith, R16G16_SFLOAT: R = A, G = B, x = n.v, y = perceptual roughness (Bevy's DfgLut)",
-                    None,
                     None,
                 );
             }
@@ -266,20 +263,19 @@ pub fn engine_files(dir: &Path, name: &str, baked: &Baked, settings: &Settings) 
             let spec = baked.specular.as_ref().ok_or_else(|| missing("specular cube"))?;
             let ibl = format!("{name}_ibl.ktx");
             let w = ktx1::write(&dir.join(&ibl), spec, &[("sh", &metadata)])?;
-            report_clamp_ktx1(&ibl, &w);
+            report_clamp(&ibl, &w);
             add(
                 ibl,
                 "GGX-prefiltered radiance (KTX 1.1, R11F_G11F_B10F), mip m at perceptual roughness 1 - sqrt(1 - m/(mips-1)); 'sh' metadata: E/pi SH for the shader",
-                None,
                 Some(w),
             );
-            let sky = Cube { layout: splitsum_shaders::cubemap::CubeLayout::new(baked.source.layout.size, 1), texels: baked.source.level(0).to_vec() };
+            let sky = baked.source.levels(0, 0);
             let skybox = format!("{name}_skybox.ktx");
             let w = ktx1::write(&dir.join(&skybox), &sky, &[])?;
-            report_clamp_ktx1(&skybox, &w);
-            add(skybox, "the environment as a cube (KTX 1.1, R11F_G11F_B10F)", None, Some(w));
+            report_clamp(&skybox, &w);
+            add(skybox, "the environment as a cube (KTX 1.1, R11F_G11F_B10F)", Some(w));
             files::write_atomic(&dir.join("sh.txt"), |w| std::io::Write::write_all(w, text.as_bytes()))?;
-            add("sh.txt".into(), "E/pi as 9 RGB coefficients of 1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2 (cmgen --sh-shader)", None, None);
+            add("sh.txt".into(), "E/pi as 9 RGB coefficients of 1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2 (cmgen --sh-shader)", None);
         }
     }
     Ok(out)
@@ -300,25 +296,20 @@ pub fn target_conventions(target: Target) -> &'static [&'static str] {
             "cube faces +X -X +Y -Y +Z -Z; the equirect's centre faces +Z (cmgen, mirrored by default): splitsum's (x, y, z) is this cube's (-x, y, -z)",
             "specular mip m holds perceptual roughness 1 - sqrt(1 - m/(mips-1)); Filament reads lod = (mips-1)*r*(2-r); mips from size down to 16x16",
             "SH: E/pi = max(0, sum c_k P_k(n)), P = 1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2 (Irradiance_SphericalHarmonics)",
-            "R11F_G11F_B10F: values above 65024 are written as 65024 and counted",
+            "R11F_G11F_B10F: values above 65024 (blue: 64512) are written as that maximum and counted",
         ],
-    }
-}
-
-fn report_clamp_ktx1(name: &str, w: &ktx1::Written) {
-    if w.clamped > 0 {
-        crate::progress::note(&format!(
-            "warning: {name}: {} values above R11F_G11F_B10F's maximum 65024 (largest {:.4e}) were written as 65024",
-            w.clamped, w.max_value
-        ));
     }
 }
 
 fn report_clamp(name: &str, w: &ktx2::Written) {
     if w.clamped > 0 {
-        let (format, max) = if w.vk_format == ktx2::VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 { ("RGB9E5", ktx2::RGB9E5_MAX) } else { ("half-float", ktx2::HALF_MAX) };
+        let (format, max, keep) = match w.vk_format {
+            ktx2::VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 => ("RGB9E5", ktx2::RGB9E5_MAX, "; the rgba32f format keeps them"),
+            ktx2::VK_FORMAT_B10G11R11_UFLOAT_PACK32 => ("R11F_G11F_B10F", UFLOAT11_MAX, " (blue: 64512), the most Filament's format holds"),
+            _ => ("half-float", ktx2::HALF_MAX, "; the rgba32f format keeps them"),
+        };
         crate::progress::note(&format!(
-            "warning: {name}: {} values above the {format} maximum {max} (largest {:.4e}) were clamped to {max}; the rgba32f format keeps them",
+            "warning: {name}: {} values above the {format} maximum {max} (largest {:.4e}) were clamped to {max}{keep}",
             w.clamped, w.max_value
         ));
     } else if w.vk_format == ktx2::VK_FORMAT_R32G32B32A32_SFLOAT && w.max_value > ktx2::HALF_MAX {
