@@ -62,12 +62,14 @@ fn bake(env: &Path, out: &Path, target: &str, extra: &[&str]) {
 }
 
 /// A KTX2 file's levels as RGBA f32 texels (faces in order, rows top to bottom), read as
-/// Bevy reads it: the `ktx2` crate's reader, then Zstandard through `ruzstd`.
+/// Bevy reads it: the `ktx2` crate's reader, then Zstandard through `ruzstd`; and each
+/// level's bytes as stored before supercompression.
 struct Ktx2 {
     size: u32,
     faces: u32,
     zstd: bool,
     levels: Vec<Vec<[f32; 4]>>,
+    bytes: Vec<Vec<u8>>,
 }
 
 fn read_ktx2(path: &Path) -> Ktx2 {
@@ -83,17 +85,22 @@ fn read_ktx2(path: &Path) -> Ktx2 {
         Some(ktx2::Format::E5B9G9R9_UFLOAT_PACK32) => (0, false),
         f => panic!("{}: unexpected format {f:?}", path.display()),
     };
-    let levels = r
+    let bytes: Vec<Vec<u8>> = r
         .levels()
         .map(|level| {
-            let data = if zstd {
+            if zstd {
                 let mut out = Vec::new();
                 ruzstd::decoding::StreamingDecoder::new(level.data).unwrap().read_to_end(&mut out).unwrap();
                 assert_eq!(out.len() as u64, level.uncompressed_byte_length);
                 out
             } else {
                 level.data.to_vec()
-            };
+            }
+        })
+        .collect();
+    let levels = bytes
+        .iter()
+        .map(|data| {
             if channels == 0 {
                 // RGB9_E5: three 9-bit mantissas and the exponent, value m·2^(e − 15 − 9).
                 return data
@@ -113,7 +120,7 @@ fn read_ktx2(path: &Path) -> Ktx2 {
             values.chunks_exact(channels).map(|c| [c[0], c[1], *c.get(2).unwrap_or(&0.0), *c.get(3).unwrap_or(&0.0)]).collect()
         })
         .collect();
-    Ktx2 { size: h.pixel_width, faces: h.face_count, zstd, levels }
+    Ktx2 { size: h.pixel_width, faces: h.face_count, zstd, levels, bytes }
 }
 
 /// An unsigned small float (5-bit exponent, bias 15, `m` mantissa bits) (OpenGL 4.6
@@ -125,11 +132,12 @@ fn small_float(bits: u32, m: u32) -> f32 {
 }
 
 /// A KTX 1.1 file: its header fields, key/value data, and levels as RGB f32
-/// (`R11F_G11F_B10F` only).
+/// (`R11F_G11F_B10F` only) and as their bytes (the faces of a level in order).
 struct Ktx1 {
     header: [u32; 13],
     kv: HashMap<String, String>,
     levels: Vec<Vec<[f32; 4]>>,
+    bytes: Vec<Vec<u8>>,
 }
 
 fn read_ktx1(path: &Path) -> Ktx1 {
@@ -150,12 +158,13 @@ fn read_ktx1(path: &Path) -> Ktx1 {
         o += 4 + len.div_ceil(4) * 4;
     }
     let (size, faces, levels) = (header[6], header[10], header[11]);
-    let mut out = Vec::new();
+    let (mut out, mut bytes) = (Vec::new(), Vec::new());
     for level in 0..levels {
         let s = (size >> level).max(1) as usize;
         let image = u(o) as usize;
         assert_eq!(image, 4 * s * s, "{}: imageSize of level {level}", path.display());
         o += 4;
+        bytes.push(b[o..o + faces as usize * image].to_vec());
         let mut texels = Vec::new();
         for _ in 0..faces {
             for t in 0..s * s {
@@ -167,7 +176,7 @@ fn read_ktx1(path: &Path) -> Ktx1 {
         out.push(texels);
     }
     assert_eq!(o, b.len(), "{}: trailing bytes", path.display());
-    Ktx1 { header, kv, levels: out }
+    Ktx1 { header, kv, levels: out, bytes }
 }
 
 fn luminance(c: [f32; 4]) -> f64 {
@@ -191,6 +200,12 @@ fn filament_sh(sh: &[f64], n: [f64; 3]) -> [f64; 3] {
     let [x, y, z] = n;
     let p = [1.0, y, z, x, y * x, y * z, 3.0 * z * z - 1.0, z * x, x * x - y * y];
     std::array::from_fn(|c| (0..9).map(|k| sh[3 * k + c] * p[k]).sum::<f64>().max(0.0))
+}
+
+/// cmgen's `sh.txt`: a line `(r, g, b); // L.., irradiance, pre-scaled base` per
+/// coefficient.
+fn read_sh_txt(path: &Path) -> Vec<f64> {
+    parse_sh(&std::fs::read_to_string(path).unwrap().lines().map(|l| l[1..l.find(')').unwrap()].replace(',', " ")).collect::<Vec<_>>().join(" "))
 }
 
 fn parse_sh(text: &str) -> Vec<f64> {
@@ -278,11 +293,7 @@ fn white_furnace_through_each_engines_formula() {
     }
     check(&read_ktx1(&f.join("filament_skybox.ktx")).levels[0], 1.0 / 64.0, "filament skybox");
     let sh = parse_sh(&ibl.kv["sh"]);
-    let from_txt: Vec<f64> = std::fs::read_to_string(f.join("sh.txt"))
-        .unwrap()
-        .lines()
-        .flat_map(|l| l[1..l.find(')').unwrap()].split(',').map(|t| t.trim().parse::<f64>().unwrap()).collect::<Vec<_>>())
-        .collect();
+    let from_txt = read_sh_txt(&f.join("sh.txt"));
     for (a, b) in sh.iter().zip(&from_txt) {
         assert!((a - b).abs() <= 1e-6 * a.abs().max(1.0), "sh.txt and the KTX's sh agree: {a} {b}");
     }
@@ -341,9 +352,7 @@ fn one_bright_texel_lands_where_each_engine_puts_it() {
     let got = brightest(&read_ktx1(&f.join("filament_skybox.ktx")).levels[0], size);
     assert!(angle(got, filament) < near, "filament skybox peak at {got:?}, cmgen's at {filament:?}");
     // SH9 of a point light peaks at the light (its zonal lobe is symmetric about it).
-    let sh = parse_sh(
-        &std::fs::read_to_string(f.join("sh.txt")).unwrap().lines().map(|l| l[1..l.find(')').unwrap()].replace(',', " ")).collect::<Vec<_>>().join(" "),
-    );
+    let sh = read_sh_txt(&f.join("sh.txt"));
     let s = 64;
     let peak = (0..6 * s * s)
         .map(|k| reference::texel_dir(k / (s * s), k % s, (k / s) % s, s))
@@ -480,36 +489,13 @@ fn every_ktx_file_loads_in_libktx() {
                     continue;
                 }
                 let loaded = libktx::load(&lib, &p).unwrap_or_else(|e| panic!("libktx refuses {}: {e}", p.display()));
-                // Each level's bytes as this test decodes them, re-encoded for comparison.
-                let (width, levels, faces, bytes): (u32, usize, u32, Vec<Vec<u8>>) = if ext == "ktx2" {
+                // Each level's bytes as this test's readers find them (zstd inflated).
+                let (width, levels, faces, bytes) = if ext == "ktx2" {
                     let f = read_ktx2(&p);
-                    let raw = std::fs::read(&p).unwrap();
-                    let r = ktx2::Reader::new(&raw[..]).unwrap();
-                    let bytes = r
-                        .levels()
-                        .map(|l| {
-                            if f.zstd {
-                                let mut out = Vec::new();
-                                std::io::Read::read_to_end(&mut ruzstd::decoding::StreamingDecoder::new(l.data).unwrap(), &mut out).unwrap();
-                                out
-                            } else {
-                                l.data.to_vec()
-                            }
-                        })
-                        .collect();
-                    (f.size, f.levels.len(), f.faces, bytes)
+                    (f.size, f.levels.len(), f.faces, f.bytes)
                 } else {
                     let f = read_ktx1(&p);
-                    let raw = std::fs::read(&p).unwrap();
-                    // Level payloads after each imageSize word.
-                    let mut o = 64 + f.header[12] as usize;
-                    let mut bytes = Vec::new();
-                    for _ in 0..f.header[11] {
-                        let n = u32::from_le_bytes(raw[o..o + 4].try_into().unwrap()) as usize;
-                        bytes.push(raw[o + 4..o + 4 + 6 * n].to_vec());
-                        o += 4 + 6 * n;
-                    }
-                    (f.header[6], f.levels.len(), f.header[10], bytes)
+                    (f.header[6], f.levels.len(), f.header[10], f.bytes)
                 };
                 assert_eq!((loaded.width, loaded.levels as usize, loaded.faces), (width, levels, faces), "{}", p.display());
                 assert_eq!(loaded.cubemap, faces == 6, "{}", p.display());
