@@ -128,7 +128,7 @@ fn an_output_folder_is_replaced_whole() {
     assert!(after.contains(&"specular_mip0.exr".to_string()) && !after.iter().any(|n| n == "specular_mip1.exr"), "{after:?}");
     let cache = d.join("cache");
     ok(&["bake", "--scene", &repo("scenes/brushed-metal.toml"), "--backend", "cpu", "--cache", cache.to_str().unwrap(), "--out", o]);
-    assert_eq!(names(&out), ["brdf_lut.exr", "plan.json", "specular.ktx2"]);
+    assert_eq!(names(&out), [".splitsum-manifest.json", "brdf_lut.exr", "plan.json", "specular.ktx2"]);
     assert_eq!(names(&d), ["cache", "out"]);
 }
 

@@ -57,7 +57,22 @@ fn write_hdr(path: &Path, w: u32, h: u32, f: impl Fn(f64, f64) -> [f64; 3]) {
 
 fn bake(env: &Path, out: &Path, target: &str, extra: &[&str]) {
     let mut args = vec!["runner", "bake", env.to_str().unwrap(), "--target", target, "--out", out.to_str().unwrap()];
-    args.extend_from_slice(extra);
+    // Filament bakes no irradiance cube and no table: the flags that size them are refused
+    // by name for it (they would change nothing), so the shared lists leave them out.
+    let mut k = 0;
+    while k < extra.len() {
+        let unread = target == "filament" && matches!(extra[k], "--irradiance-size" | "--lut-size");
+        if !unread {
+            args.push(extra[k]);
+            if k + 1 < extra.len() && extra[k].starts_with("--") && !extra[k + 1].starts_with("--") {
+                args.push(extra[k + 1]);
+                k += 1;
+            }
+        } else {
+            k += 1;
+        }
+        k += 1;
+    }
     runner::cli::run(args).unwrap_or_else(|e| panic!("bake --target {target}: {e:#}"));
 }
 

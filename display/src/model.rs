@@ -108,72 +108,189 @@ pub static EMBEDDED_SAMPLE: &[u8] = include_bytes!("../../assets/models/torus.gl
 /// Decodes [`EMBEDDED_SAMPLE`].
 pub fn embedded_sample() -> Result<Model> {
     let path = Path::new("<embedded torus.glb>");
-    let (doc, buffers, images) = gltf::import_slice(EMBEDDED_SAMPLE).map_err(|e| Error::file(path, format!("cannot load the glTF: {e}")))?;
+    let (doc, buffers, images) = import(path, EMBEDDED_SAMPLE, None)?;
     from_document(path, doc, buffers, images)
 }
 
 /// Where a model goes beside the sphere grid, and how large it is.
 pub const PLACE_BESIDE_GRID: (Vec3, f32) = (Vec3::new(5.4, 0.0, 0.0), 3.2);
 
-/// Loads the default scene of a `.gltf` or `.glb` file.
+/// The largest texture side a model may use (a texture of 8192² is 256 MiB as RGBA8); a
+/// header that claims more is refused before its pixels are allocated.
+pub const MAX_TEXTURE: u32 = 8192;
+
+/// Loads the default scene of a `.gltf` or `.glb` file. Memory stays within what the file
+/// and the files it names hold, plus the decoded textures (each at most
+/// [`MAX_TEXTURE`]²): buffers are read only from regular files, and no further than the
+/// length the document gives them.
 pub fn load(path: &Path) -> Result<Model> {
-    check_extensions(path)?;
-    // The glTF crate panics on some malformed files even while importing them validated
-    // (an embedded image without a MIME type: `image.rs`, an `unwrap`); so does reading an
-    // unvalidated document whose indices point past its arrays. Both become an error
-    // about the file.
+    let bytes = read_regular(path, None)?;
+    // The glTF crate panics on some malformed documents (an unvalidated document whose
+    // indices point past its arrays, for one): such a panic becomes an error about the file.
     let malformed = |_| Err(Error::file(path, "malformed glTF (an index points past its array, or a required field is missing)"));
-    let validated = match std::panic::catch_unwind(|| gltf::import(path)) {
-        Ok(v) => v,
-        Err(p) => return malformed(p),
-    };
-    let (doc, buffers, images) = match validated {
-        Ok(imported) => imported,
-        // Draco primitives' accessors have no bufferView (their data is in the extension's),
-        // which the validator reports as missing data: read such a file unvalidated.
-        Err(_) if uses_draco(path) => match std::panic::catch_unwind(|| import_unvalidated(path)) {
-            Ok(imported) => imported?,
-            Err(p) => return malformed(p),
-        },
-        Err(e) => return Err(Error::file(path, format!("cannot load the glTF: {e}"))),
-    };
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| from_document(path, doc, buffers, images))).unwrap_or_else(malformed)
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let (doc, buffers, images) = import(path, &bytes, Some(path.parent().unwrap_or(Path::new("."))))?;
+        from_document(path, doc, buffers, images)
+    }))
+    .unwrap_or_else(malformed)
 }
 
 /// The name of the Draco extension (Khronos, `KHR_draco_mesh_compression`).
 const DRACO: &str = "KHR_draco_mesh_compression";
 
-fn uses_draco(path: &Path) -> bool {
-    std::fs::read(path).ok().and_then(|b| gltf::Gltf::from_slice_without_validation(&b).ok()).is_some_and(|g| g.extensions_used().any(|e| e == DRACO))
+/// Reads the regular file `path` whole, or its first `limit` bytes; a folder, a device or
+/// a pipe (which could be endless) is refused.
+fn read_regular(path: &Path, limit: Option<u64>) -> Result<Vec<u8>> {
+    use std::io::Read;
+    let file = std::fs::File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let meta = file.metadata().map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    if !meta.is_file() {
+        return Err(Error::file(path, "is not a regular file"));
+    }
+    let want = limit.unwrap_or(meta.len()).min(meta.len());
+    let mut bytes = Vec::with_capacity(want as usize);
+    file.take(want).read_to_end(&mut bytes).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    Ok(bytes)
 }
 
-fn import_unvalidated(path: &Path) -> Result<(gltf::Document, Vec<gltf::buffer::Data>, Vec<gltf::image::Data>)> {
+/// The document of the glTF or GLB `bytes`, its buffers and its images, decoded. `base` is
+/// the folder that relative URIs name files in (`None`: the document may name no file).
+/// Every buffer is read from a data URI, the GLB's binary chunk or a regular file, no
+/// further than its `byteLength`; every image is decoded within [`MAX_TEXTURE`].
+fn import(path: &Path, bytes: &[u8], base: Option<&Path>) -> Result<(gltf::Document, Vec<gltf::buffer::Data>, Vec<gltf::image::Data>)> {
     let fail = |e: gltf::Error| Error::file(path, format!("cannot load the glTF: {e}"));
-    let bytes = std::fs::read(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(&bytes).map_err(fail)?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(fail)?;
-    let images = gltf::import_images(&document, Some(base), &buffers).map_err(fail)?;
+    if let [b'g', b'l', b'T', b'F', _, _, _, _, l0, l1, l2, l3, ..] = *bytes {
+        let declared = u32::from_le_bytes([l0, l1, l2, l3]) as usize;
+        if declared > bytes.len() {
+            return Err(Error::file(path, format!("truncated GLB: its header says {declared} bytes, the file has {}", bytes.len())));
+        }
+    }
+    let unvalidated = gltf::Gltf::from_slice_without_validation(bytes).map_err(fail)?;
+    for (ext, fix) in UNSUPPORTED {
+        if unvalidated.extensions_used().chain(unvalidated.extensions_required()).any(|e| e == ext) {
+            return Err(Error::file(path, format!("uses {ext} (compressed meshes), which splitsum does not decode; {fix}")));
+        }
+    }
+    // Draco primitives' accessors have no bufferView (their data is in the extension's),
+    // which the validator reports as missing data: such a document is read unvalidated.
+    let gltf::Gltf { document, blob } = if unvalidated.extensions_used().any(|e| e == DRACO) {
+        unvalidated
+    } else {
+        drop(unvalidated);
+        gltf::Gltf::from_slice(bytes).map_err(fail)?
+    };
+    let mut blob = blob;
+    let mut buffers = Vec::new();
+    for buffer in document.buffers() {
+        let length = buffer.length();
+        let mut data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| Error::file(path, format!("buffer {} names a binary chunk the file lacks", buffer.index())))?,
+            gltf::buffer::Source::Uri(uri) => read_uri(path, base, uri, Some(length as u64))?,
+        };
+        if data.len() < length {
+            return Err(Error::file(path, format!("buffer {} holds {} bytes, but its byteLength is {length}", buffer.index(), data.len())));
+        }
+        while data.len() % 4 != 0 {
+            data.push(0);
+        }
+        buffers.push(gltf::buffer::Data(data));
+    }
+    // Every accessor within its bufferView, before anything reads it (the glTF crate's
+    // reader would silently give nothing for one that is not).
+    for a in document.accessors() {
+        if let Some(view) = a.view() {
+            let element = a.size();
+            let stride = view.stride().unwrap_or(element);
+            let need = (a.count() as u64).checked_sub(1).map_or(0, |n| a.offset() as u64 + n * stride as u64 + element as u64);
+            if need > view.length() as u64 {
+                return Err(Error::file(
+                    path,
+                    format!("accessor {} claims {} elements, which take {need} bytes, but its bufferView {} holds {}", a.index(), a.count(), view.index(), view.length()),
+                ));
+            }
+        }
+    }
+    let mut images = Vec::new();
+    for image in document.images() {
+        let (encoded, mime) = match image.source() {
+            gltf::image::Source::View { view, mime_type } => {
+                let data = &buffers.get(view.buffer().index()).ok_or_else(|| Error::file(path, format!("image {} names a missing buffer", image.index())))?.0;
+                let bytes = data.get(view.offset()..view.offset() + view.length()).ok_or_else(|| Error::file(path, format!("image {}'s bufferView runs past its buffer", image.index())))?;
+                (std::borrow::Cow::Borrowed(bytes), Some(mime_type))
+            }
+            gltf::image::Source::Uri { uri, mime_type } => (std::borrow::Cow::Owned(read_uri(path, base, uri, None)?), mime_type),
+        };
+        images.push(decode_image(path, image.index(), &encoded, mime)?);
+    }
     Ok((document, buffers, images))
+}
+
+/// The bytes a URI of the document at `path` names: a base64 data URI, or a regular file
+/// relative to `base` (at most `limit` bytes of it).
+fn read_uri(path: &Path, base: Option<&Path>, uri: &str, limit: Option<u64>) -> Result<Vec<u8>> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let payload = rest.split_once(";base64,").map_or(rest, |(_, b)| b);
+        return base64::decode(payload).map_err(|e| Error::file(path, format!("a data URI is not valid base64: {e}")));
+    }
+    let Some(base) = base else {
+        return Err(Error::file(path, format!("names the file {uri:?}, but an embedded model may name none")));
+    };
+    let relative = uri.strip_prefix("file://").or_else(|| uri.strip_prefix("file:")).unwrap_or(uri);
+    if relative.contains("://") {
+        return Err(Error::file(path, format!("names {uri:?}, which is neither a data URI nor a file")));
+    }
+    let decoded = percent_decode(relative);
+    read_regular(&base.join(decoded), limit).map_err(|e| Error::file(path, format!("{uri:?}: {e}")))
+}
+
+/// `%XX` escapes of a URI decoded (glTF 2.0 §3.3: URIs are RFC 3986).
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        match (b[i], b.get(i + 1).and_then(|&c| hex(c)), b.get(i + 2).and_then(|&c| hex(c))) {
+            (b'%', Some(h), Some(l)) => {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+            }
+            (c, _, _) => {
+                out.push(c);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Decodes image `index` (PNG or JPEG, by its MIME type or its signature) as 8-bit RGBA,
+/// within [`MAX_TEXTURE`] on a side: the header is checked before pixels are allocated.
+fn decode_image(path: &Path, index: usize, encoded: &[u8], mime: Option<&str>) -> Result<gltf::image::Data> {
+    let format = match mime {
+        Some("image/png") => image::ImageFormat::Png,
+        Some("image/jpeg") => image::ImageFormat::Jpeg,
+        _ => match image::guess_format(encoded) {
+            Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => f,
+            _ => return Err(Error::file(path, format!("image {index} is neither PNG nor JPEG (the formats glTF 2.0 allows)"))),
+        },
+    };
+    let mut reader = image::ImageReader::with_format(std::io::Cursor::new(encoded), format);
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(MAX_TEXTURE);
+    limits.max_image_height = Some(MAX_TEXTURE);
+    limits.max_alloc = Some(4 * (MAX_TEXTURE as u64).pow(2));
+    reader.limits(limits);
+    let img = reader.decode().map_err(|e| match e {
+        image::ImageError::Limits(_) => Error::file(path, format!("image {index} is larger than the {MAX_TEXTURE}×{MAX_TEXTURE} texels a texture may have")),
+        e => Error::file(path, format!("image {index} cannot be decoded: {e}")),
+    })?;
+    let (width, height) = (img.width(), img.height());
+    Ok(gltf::image::Data { pixels: img.into_rgba8().into_raw(), format: gltf::image::Format::R8G8B8A8, width, height })
 }
 
 /// Extensions a model may use that the loader cannot read, and what to do instead.
 const UNSUPPORTED: [(&str, &str); 1] = [("EXT_meshopt_compression", "decompress it first, e.g. `npx gltf-transform copy in.glb out.glb`")];
-
-/// Refuses, before loading, a model whose meshes use a compression this loader does not
-/// decode (naming the extension), rather than failing on the accessors it leaves empty.
-fn check_extensions(path: &Path) -> Result<()> {
-    let bytes = std::fs::read(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let Ok(doc) = gltf::Gltf::from_slice_without_validation(&bytes) else {
-        return Ok(()); // malformed: the loader's own error says how
-    };
-    for (ext, fix) in UNSUPPORTED {
-        if doc.extensions_used().chain(doc.extensions_required()).any(|e| e == ext) {
-            return Err(Error::file(path, format!("uses {ext} (compressed meshes), which splitsum does not decode; {fix}")));
-        }
-    }
-    Ok(())
-}
 
 fn from_document(path: &Path, doc: gltf::Document, buffers: Vec<gltf::buffer::Data>, images: Vec<gltf::image::Data>) -> Result<Model> {
     let scene = doc.default_scene().or_else(|| doc.scenes().next()).ok_or_else(|| Error::file(path, "has no scene"))?;

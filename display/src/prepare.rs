@@ -66,6 +66,7 @@ pub fn bake_scene(
             splitsum::cache::Lookup::Hit(env) => return Ok(SceneBake { plan, env: *env, key, outcome: Outcome::CacheHit, timings: Vec::new() }),
             splitsum::cache::Lookup::Miss => {}
             splitsum::cache::Lookup::Rejected(why) => outcome = Outcome::Rebuilt(why),
+            splitsum::cache::Lookup::Foreign(e) => return Err(e),
         }
     }
     check_duration(&step_estimates(backend.is_gpu(), &env, &plan.settings, plan.products, &plan.levels), force)?;

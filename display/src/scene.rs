@@ -359,7 +359,7 @@ impl Scene {
     pub fn load(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
         let mut scene = Self::parse(&text).map_err(|e| match e {
-            Error::Invalid(m) => Error::file(path, m),
+            Error::Invalid(m) => Error::Invalid(format!("{}: {m}", path.display())),
             other => other,
         })?;
         scene.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();

@@ -143,6 +143,7 @@ fn manifest_files(dir: &Path) -> Vec<String> {
     let json: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("bake.json")).unwrap()).unwrap();
     let mut v: Vec<String> = json["files"].as_array().unwrap().iter().map(|f| f["name"].as_str().unwrap().to_string()).collect();
     v.push("bake.json".into());
+    v.push(splitsum::files::OUTPUT_MANIFEST.into());
     v.sort();
     v
 }
@@ -330,4 +331,238 @@ fn each_step_reports_its_start_and_estimate() {
     for step in ["reading ", "source cube…", "specular… (estimate ", "irradiance…", "brdf lut… (estimate ", "writing the files…"] {
         assert!(err.lines().any(|l| l.starts_with(step)), "no line starting {step:?}:\n{err}");
     }
+}
+
+/// A small RGB OpenEXR (a gradient, f16) written with `compression` and `blocks`.
+fn small_exr(path: &Path, compression: exr::prelude::Compression, blocks: exr::prelude::Blocks) {
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| (f16::from_f32(p.x() as f32 * 0.01), f16::from_f32(0.5), f16::from_f32(p.y() as f32 * 0.02)));
+    let encoding = Encoding { compression, blocks, line_order: LineOrder::Increasing };
+    Image::from_layer(Layer::new((64, 32), LayerAttributes::default(), encoding, channels)).write().to_file(path).unwrap();
+}
+
+/// Rewrites the box2i attribute `name` of the first header of the OpenEXR at `path` (the
+/// header as written, not as parsed: a hostile header).
+fn patch_box(path: &Path, name: &str, b: [i32; 4]) {
+    let mut bytes = std::fs::read(path).unwrap();
+    let key = format!("{name}\0box2i\0");
+    let at = bytes.windows(key.len()).position(|w| w == key.as_bytes()).unwrap() + key.len() + 4;
+    for (k, v) in b.iter().enumerate() {
+        bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// Sets the compression byte of the first header of the OpenEXR at `path`.
+fn patch_compression(path: &Path, code: u8) {
+    let mut bytes = std::fs::read(path).unwrap();
+    let key = b"compression\0compression\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    bytes[at] = code;
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// Every read path keeps within 64 MiB + 4 × the file's size + what the same command
+/// needs on a small valid input (the bake and render at those settings), on truncated,
+/// lying and hostile headers: OpenEXR of every compression (cut short, or claiming
+/// 32768×16384 in a 10 KiB file, or 1×1 tiles over that size), Radiance `.hdr`, face
+/// folders, glTF/GLB models and cache entries. Each is refused with a message that says
+/// what is wrong, and exits 1.
+#[test]
+fn hostile_headers_stay_within_memory_bounds() {
+    use exr::prelude::{Blocks, Compression, Vec2};
+    let d = scratch("hostile");
+    let bake = |input: &Path| {
+        let mut c = runner();
+        c.args(["bake", input.to_str().unwrap(), "--backend", "cpu", "--size", "16", "--out", d.join("out").to_str().unwrap()]);
+        c
+    };
+    // What the same command needs on a valid input of the same kind.
+    let valid = d.join("valid.exr");
+    small_exr(&valid, Compression::ZIP16, Blocks::ScanLines);
+    let (ok, said, baseline) = run_measured(bake(&valid), &d);
+    assert!(ok, "{said}");
+    let mut cases: Vec<(String, PathBuf, &str)> = Vec::new();
+    let compressions = [
+        Compression::Uncompressed,
+        Compression::RLE,
+        Compression::ZIP1,
+        Compression::ZIP16,
+        Compression::PIZ,
+        Compression::PXR24,
+        Compression::B44,
+        Compression::B44A,
+        Compression::DWAA(None),
+        Compression::DWAB(None),
+    ];
+    for (k, c) in compressions.into_iter().enumerate() {
+        let whole = d.join(format!("c{k}.exr"));
+        small_exr(&whole, c, Blocks::ScanLines);
+        let bytes = std::fs::read(&whole).unwrap();
+        // Cut short after its header.
+        let cut = d.join(format!("c{k}-cut.exr"));
+        std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
+        cases.push((format!("{c:?} cut short"), cut, "OpenEXR"));
+        // The header claims 32768×16384; the file stays as small as it was.
+        let lying = d.join(format!("c{k}-lying.exr"));
+        std::fs::write(&lying, &bytes).unwrap();
+        patch_box(&lying, "dataWindow", [0, 0, 32767, 16383]);
+        patch_box(&lying, "displayWindow", [0, 0, 32767, 16383]);
+        cases.push((format!("{c:?} lying about its size"), lying, "OpenEXR"));
+    }
+    // A header claiming every compression code over the same lying size.
+    for code in 0..10u8 {
+        let p = d.join(format!("code{code}.exr"));
+        small_exr(&p, Compression::ZIP16, Blocks::ScanLines);
+        patch_box(&p, "dataWindow", [0, 0, 32767, 16383]);
+        patch_box(&p, "displayWindow", [0, 0, 32767, 16383]);
+        patch_compression(&p, code);
+        cases.push((format!("compression code {code}, lying"), p, "OpenEXR"));
+    }
+    // 1×1 tiles over 32768×16384: 5·10⁸ blocks promised, whose offset table alone would be 4 GiB.
+    let tiles = d.join("tiles.exr");
+    small_exr(&tiles, Compression::Uncompressed, Blocks::Tiles(Vec2(1, 1)));
+    patch_box(&tiles, "dataWindow", [0, 0, 32767, 16383]);
+    patch_box(&tiles, "displayWindow", [0, 0, 32767, 16383]);
+    cases.push(("1×1 tiles, lying".into(), tiles, "truncated OpenEXR: its header promises 32768×16384 pixels in 536870912 blocks"));
+    let inverted = d.join("inverted.exr");
+    small_exr(&inverted, Compression::ZIP16, Blocks::ScanLines);
+    patch_box(&inverted, "dataWindow", [63, 31, 0, 0]);
+    cases.push(("inverted data window".into(), inverted, "data window is inverted"));
+    // Radiance: a header promising 32768×16384, then a few bytes of scanline.
+    let hdr = d.join("lying.hdr");
+    let mut b = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16384 +X 32768\n".to_vec();
+    b.extend(std::iter::repeat_n([2u8, 2, 128, 0], 20000).flatten());
+    std::fs::write(&hdr, &b).unwrap();
+    cases.push(("hdr lying about its size".into(), hdr, "Radiance HDR"));
+    let no_res = d.join("nores.hdr");
+    let mut b = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n".to_vec();
+    b.extend((0..4096u32).map(|i| (i * 37 % 251) as u8 | 0x80));
+    std::fs::write(&no_res, &b).unwrap();
+    cases.push(("hdr without a resolution line".into(), no_res, "no resolution line"));
+    // A face folder whose +Y face lies about its size (32768²), beside valid 64² faces.
+    let faces = d.join("faces");
+    std::fs::create_dir_all(&faces).unwrap();
+    for name in ["px", "nx", "py", "ny", "pz", "nz"] {
+        let p = faces.join(format!("{name}.exr"));
+        use exr::prelude::*;
+        let ch = SpecificChannels::rgb(|_: Vec2<usize>| (f16::ONE, f16::ONE, f16::ONE));
+        Image::from_channels((64, 64), ch).write().to_file(&p).unwrap();
+        if name == "py" {
+            patch_box(&p, "dataWindow", [0, 0, 32767, 32767]);
+            patch_box(&p, "displayWindow", [0, 0, 32767, 32767]);
+        }
+    }
+    cases.push(("face folder with a lying face".into(), faces, "py.exr"));
+    let render = |model: &Path| {
+        let mut c = runner();
+        let out = d.join("frame.png");
+        c.args(["render", "--backend", "cpu", "--size", "16", "--samples", "16", "--width", "32", "--height", "16", "--model", model.to_str().unwrap()]);
+        c.args(["--out", out.to_str().unwrap()]);
+        c
+    };
+    let torus = d.join("torus.glb");
+    std::fs::write(&torus, std::fs::read(format!("{}/../assets/models/torus.glb", env!("CARGO_MANIFEST_DIR"))).unwrap()).unwrap();
+    let (ok, said, model_baseline) = run_measured(render(&torus), &d);
+    assert!(ok, "{said}");
+    let mut models: Vec<(String, PathBuf, &str)> = Vec::new();
+    let glb = std::fs::read(&torus).unwrap();
+    let cut = d.join("cut.glb");
+    std::fs::write(&cut, &glb[..glb.len() / 2]).unwrap();
+    models.push(("GLB cut short".into(), cut, "truncated GLB"));
+    let (json, bin) = split_glb(&glb);
+    let edit = |name: &str, f: &dyn Fn(&mut serde_json::Value)| {
+        let mut j: serde_json::Value = serde_json::from_slice(&json).unwrap();
+        f(&mut j);
+        let p = d.join(name);
+        std::fs::write(&p, join_glb(&serde_json::to_vec(&j).unwrap(), &bin)).unwrap();
+        p
+    };
+    // A second buffer read from an endless device: refused, never read.
+    let endless = edit("endless.glb", &|j| j["buffers"].as_array_mut().unwrap().push(serde_json::json!({"uri": "file:///dev/zero", "byteLength": 1u64 << 31})));
+    models.push(("a buffer naming /dev/zero".into(), endless, "not a regular file"));
+    // A binary chunk claiming 2 GiB.
+    let long = edit("long.glb", &|j| j["buffers"][0]["byteLength"] = serde_json::json!(1u64 << 31));
+    models.push(("a buffer claiming 2 GiB".into(), long, "byteLength"));
+    // An accessor claiming 2³⁰ vertices in a small buffer view.
+    let many = edit("many.glb", &|j| j["accessors"][0]["count"] = serde_json::json!(1u64 << 30));
+    models.push(("an accessor claiming 2^30 vertices".into(), many, "accessor 0 claims 1073741824 elements"));
+    // Images whose PNG header claims 65535² and 8000² (within the texture limit) over the
+    // same few compressed bytes.
+    for (side, message) in [(65535u32, "larger than the 8192×8192"), (8000, "cannot be decoded")] {
+        let mut b = bin.clone();
+        let at = b.windows(8).position(|w| w == b"\x89PNG\r\n\x1a\n").expect("a PNG in the sample");
+        let ihdr = at + 8 + 8;
+        b[ihdr..ihdr + 4].copy_from_slice(&side.to_be_bytes());
+        b[ihdr + 4..ihdr + 8].copy_from_slice(&side.to_be_bytes());
+        let crc = crc32(&b[ihdr - 4..ihdr + 13]);
+        b[ihdr + 13..ihdr + 17].copy_from_slice(&crc.to_be_bytes());
+        let p = d.join(format!("png{side}.glb"));
+        std::fs::write(&p, join_glb(&json, &b)).unwrap();
+        models.push((format!("a PNG claiming {side}²"), p, message));
+    }
+    for (what, input, message) in &models {
+        let len = std::fs::metadata(input).unwrap().len();
+        let (ok, said, peak) = run_measured(render(input), &d);
+        let bound = (64 << 20) + 4 * len + model_baseline;
+        eprintln!("{what}: peak {:.1} MiB (bound {:.1} MiB): {}", peak as f64 / 1048576.0, bound as f64 / 1048576.0, said.lines().last().unwrap_or(""));
+        assert!(!ok, "{what}: {said}");
+        assert!(said.contains(message), "{what}: expected {message:?} in: {said}");
+        assert!(peak <= bound, "{what}: peak {peak} bytes > bound {bound}: {said}");
+    }
+    for (what, input, message) in &cases {
+        let len = std::fs::metadata(input).map(|m| if m.is_dir() { 6 * 16 << 10 } else { m.len() }).unwrap();
+        let (ok, said, peak) = run_measured(bake(input), &d);
+        let bound = (64 << 20) + 4 * len + baseline;
+        eprintln!("{what}: peak {:.1} MiB (bound {:.1} MiB): {}", peak as f64 / 1048576.0, bound as f64 / 1048576.0, said.lines().last().unwrap_or(""));
+        assert!(!ok, "{what}: {said}");
+        assert!(said.contains(message), "{what}: expected {message:?} in: {said}");
+        assert!(peak <= bound, "{what}: peak {peak} bytes > bound {bound}: {said}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The JSON and binary chunks of a GLB.
+fn split_glb(glb: &[u8]) -> (Vec<u8>, Vec<u8>) {
+    let u32_at = |i: usize| u32::from_le_bytes(glb[i..i + 4].try_into().unwrap()) as usize;
+    let json_len = u32_at(12);
+    let json = glb[20..20 + json_len].to_vec();
+    let bin_at = 20 + json_len;
+    let bin_len = u32_at(bin_at);
+    (json, glb[bin_at + 8..bin_at + 8 + bin_len].to_vec())
+}
+
+/// A GLB of a JSON chunk (padded with spaces) and a binary chunk (padded with zeros).
+fn join_glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let pad = |v: &[u8], with: u8| {
+        let mut v = v.to_vec();
+        while v.len() % 4 != 0 {
+            v.push(with);
+        }
+        v
+    };
+    let (j, b) = (pad(json, b' '), pad(bin, 0));
+    let mut out = Vec::new();
+    out.extend_from_slice(b"glTF");
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&((12 + 8 + j.len() + 8 + b.len()) as u32).to_le_bytes());
+    out.extend_from_slice(&(j.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&j);
+    out.extend_from_slice(&(b.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&b);
+    out
+}
+
+/// CRC-32 (ISO-HDLC, as PNG chunks carry it), bit by bit.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 { 0xEDB8_8320 ^ (c >> 1) } else { c >> 1 };
+        }
+    }
+    !c
 }

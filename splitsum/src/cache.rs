@@ -62,6 +62,35 @@ struct Manifest {
     files: BTreeMap<String, FileEntry>,
 }
 
+/// The files of an entry, as [`Cache::put`] writes them: the only names the cache removes.
+const ENTRY_FILES: [&str; 5] = ["manifest.json", "source.bin", "specular.bin", "irradiance.bin", "lut.bin"];
+
+/// The largest entry manifest read (a real one is under a kilobyte).
+const MAX_MANIFEST_BYTES: u64 = 1 << 20;
+
+/// Removes the entry folder `dir`, only if it holds nothing but the files the cache writes
+/// (`ENTRY_FILES`); otherwise it is left as it is, and the error names what the cache did
+/// not write.
+fn remove_entry(dir: &Path) -> Result<()> {
+    let entries: Vec<_> = std::fs::read_dir(dir)
+        .and_then(|r| r.collect::<std::io::Result<Vec<_>>>())
+        .map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))?;
+    for e in &entries {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let is_file = e.file_type().is_ok_and(|t| t.is_file());
+        if !is_file || !ENTRY_FILES.contains(&name.as_str()) {
+            return Err(Error::file(
+                dir,
+                format!("this cache entry holds {name}, which splitsum did not write; the cache removes only its own files: move it away, or use another cache folder"),
+            ));
+        }
+    }
+    for e in &entries {
+        std::fs::remove_file(e.path()).map_err(|err| Error::file(&e.path(), format!("cannot remove the stale cache file: {err}")))?;
+    }
+    std::fs::remove_dir(dir).map_err(|e| Error::file(dir, format!("cannot remove the stale cache entry: {e}")))
+}
+
 /// What a lookup found.
 pub enum Lookup {
     /// A valid entry.
@@ -70,6 +99,9 @@ pub enum Lookup {
     Miss,
     /// An entry that may not be used, and why; it has been removed.
     Rejected(String),
+    /// An entry that may not be used and holds files the cache did not write: left as it
+    /// is, and the error says what is in the way.
+    Foreign(Error),
 }
 
 /// A cache folder.
@@ -139,24 +171,41 @@ impl Cache {
         }
         match self.read(key, &dir) {
             Ok(env) => Lookup::Hit(Box::new(env)),
-            Err(why) => {
-                let _ = std::fs::remove_dir_all(&dir);
-                Lookup::Rejected(why)
-            }
+            Err(why) => match remove_entry(&dir) {
+                Ok(()) => Lookup::Rejected(why),
+                Err(e) => Lookup::Foreign(e),
+            },
         }
     }
 
     fn read(&self, key: &str, dir: &Path) -> std::result::Result<BakedEnvironment, String> {
-        let text = std::fs::read_to_string(dir.join("manifest.json")).map_err(|e| format!("no readable manifest ({e})"))?;
+        let manifest = dir.join("manifest.json");
+        match std::fs::metadata(&manifest) {
+            Ok(m) if m.len() > MAX_MANIFEST_BYTES => return Err(format!("a manifest of {} bytes is not one of ours", m.len())),
+            _ => {}
+        }
+        let text = std::fs::read_to_string(&manifest).map_err(|e| format!("no readable manifest ({e})"))?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| format!("malformed manifest ({e})"))?;
         if m.format != FORMAT || m.key != key {
             return Err(format!("a foreign entry (its manifest names key {} in format {})", m.key, m.format));
         }
         let file = |name: &str| -> std::result::Result<Vec<u8>, String> {
             let want = m.files.get(name).ok_or_else(|| format!("the manifest lists no {name}"))?;
+            // The size first: a file longer than the manifest says is never read in.
+            let len = std::fs::metadata(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?.len();
+            if len != want.bytes {
+                return Err(format!("{name} is corrupt (it holds {len} bytes, the manifest says {})", want.bytes));
+            }
+            // Then the hash, streamed: a file that is not what the manifest says is never held.
+            let mut h = blake3::Hasher::new();
+            let file = std::fs::File::open(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?;
+            h.update_reader(file).map_err(|e| format!("{name} unreadable ({e})"))?;
+            if h.finalize().to_hex().as_str() != want.blake3 {
+                return Err(format!("{name} is corrupt (its BLAKE3 hash differs from the manifest)"));
+            }
             let bytes = std::fs::read(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?;
-            if bytes.len() as u64 != want.bytes || blake3::hash(&bytes).to_hex().as_str() != want.blake3 {
-                return Err(format!("{name} is corrupt (size or BLAKE3 hash differs from the manifest)"));
+            if bytes.len() as u64 != want.bytes {
+                return Err(format!("{name} changed while it was read"));
             }
             Ok(bytes)
         };
@@ -195,7 +244,15 @@ impl Cache {
         let manifest = Manifest { format: FORMAT.into(), key: key.into(), mapping: env.mapping as u32, files };
         std::fs::write(tmp.join("manifest.json"), serde_json::to_string_pretty(&manifest).expect("serialisable")).map_err(fail)?;
         let dest = self.entry(key);
-        let _ = std::fs::remove_dir_all(&dest);
-        std::fs::rename(&tmp, &dest).map_err(fail)
+        if dest.exists() {
+            if let Err(e) = remove_entry(&dest) {
+                let _ = std::fs::remove_dir_all(&tmp);
+                return Err(e);
+            }
+        }
+        std::fs::rename(&tmp, &dest).map_err(|e| {
+            let _ = std::fs::remove_dir_all(&tmp);
+            fail(e)
+        })
     }
 }

@@ -9,6 +9,7 @@
 //! for; then NaN and −∞ become 0 and +∞ becomes the largest finite value of its channel in
 //! the image (then clamped like any other).
 
+use crate::adjustment::Adjustment;
 use crate::error::{Error, Result};
 use crate::texture::{Cube, Equirect};
 use splitsum_shaders::cubemap::{self, CubeLayout};
@@ -19,8 +20,8 @@ use std::path::{Path, PathBuf};
 
 /// Largest image side accepted (a 32768×16384 RGBA f32 equirect is 8 GiB).
 pub const MAX_SIDE: u32 = 32768;
-/// Largest cube face accepted (a face is read whole before it is reduced: 1 GiB at 8192²).
-pub const MAX_FACE: u32 = 8192;
+/// Largest cube face accepted (faces are reduced as they are decoded, as equirects are).
+pub const MAX_FACE: u32 = MAX_SIDE;
 /// Smallest equirect accepted.
 pub const MIN_WIDTH: u32 = 8;
 
@@ -37,9 +38,15 @@ impl Environment {
     /// The environment's own resolution as a cube face size (a quarter of an equirect's
     /// width, as a power of two, at most [`NATIVE_FACE`]).
     pub fn native_face_size(&self) -> u32 {
+        self.resolves().min(NATIVE_FACE)
+    }
+
+    /// The cube face size the environment resolves: a quarter of an equirect's width (the
+    /// next power of two, at least 8), or a cube's own face size.
+    pub fn resolves(&self) -> u32 {
         match self {
-            Environment::Equirect(e) => (e.width / 4).max(8).next_power_of_two().min(NATIVE_FACE),
-            Environment::Cube(c) => c.layout.size.min(NATIVE_FACE),
+            Environment::Equirect(e) => (e.width / 4).max(8).next_power_of_two(),
+            Environment::Cube(c) => c.layout.size,
         }
     }
 }
@@ -61,9 +68,33 @@ pub struct InputReport {
     pub max_value: f32,
     /// Width and height of the file (of one face, for a cube), before any reduction.
     pub original: (u32, u32),
+    /// The cube face size the environment was read for (see [`load_for`]).
+    pub read_for: u32,
 }
 
 impl InputReport {
+    /// What reading changed, with `env` as read: a reduction, negative texels set to 0,
+    /// texels clamped, NaN and ∞ replaced.
+    pub fn adjustments(&self, env: &Environment) -> Vec<Adjustment> {
+        let mut out = Vec::new();
+        let (w, h) = self.original;
+        match env {
+            Environment::Equirect(e) if e.width < w => out.push(Adjustment::Reduced { from: (w, h), to: (e.width, e.height), source_size: self.read_for }),
+            Environment::Cube(c) if c.layout.size < w => out.push(Adjustment::FacesReduced { from: w, to: c.layout.size }),
+            _ => {}
+        }
+        if self.negative > 0 {
+            out.push(Adjustment::NegativeTexels { count: self.negative });
+        }
+        if self.clamped > 0 {
+            out.push(Adjustment::ClampedTexels { count: self.clamped, max: MAX_RADIANCE });
+        }
+        if self.sanitized && (self.nan > 0 || self.infinite > 0) {
+            out.push(Adjustment::Sanitized { nan: self.nan, infinite: self.infinite });
+        }
+        out
+    }
+
     fn add(&mut self, r: &InputReport) {
         self.negative += r.negative;
         self.clamped += r.clamped;
@@ -94,50 +125,57 @@ pub fn load(path: &Path, sanitize: bool) -> Result<(Environment, InputReport)> {
 pub fn load_for(path: &Path, sanitize: bool, face: u32) -> Result<(Environment, InputReport)> {
     if path.is_dir() {
         let faces = face_paths(path)?;
-        return load_faces(&faces, sanitize, face);
+        let (env, report) = load_faces(&faces, sanitize, face)?;
+        return Ok((env, InputReport { read_for: face, ..report }));
     }
     let (width, height) = dimensions(path)?;
     check_equirect_shape(path, width, height)?;
     let factor = equirect::reduction_factor(width, height, face);
     let (image, report) = read_reduced(path, sanitize, factor)?;
-    Ok((Environment::Equirect(image), report))
+    Ok((Environment::Equirect(image), InputReport { read_for: face, ..report }))
 }
 
 /// The six face files of a cube map folder.
 pub fn face_paths(dir: &Path) -> Result<[PathBuf; 6]> {
     let find = |name: &str| -> Result<PathBuf> {
+        let mut found = Vec::new();
         for ext in ["exr", "hdr"] {
             let p = dir.join(format!("{name}.{ext}"));
-            if p.is_file() {
-                return Ok(p);
+            match std::fs::metadata(&p) {
+                Ok(m) if m.is_file() => found.push(p),
+                Ok(m) if m.is_dir() => return Err(Error::file(&p, "is a folder; a cube face must be an .exr or .hdr file")),
+                Ok(_) => return Err(Error::file(&p, "is not a regular file; a cube face must be an .exr or .hdr file")),
+                Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                    if std::fs::symlink_metadata(&p).is_ok() {
+                        return Err(Error::file(&p, "is a symbolic link to nothing"));
+                    }
+                }
+                Err(e) => return Err(Error::file(&p, format!("cannot read: {e}"))),
             }
         }
-        Err(Error::file(dir, format!("no face `{name}.exr` or `{name}.hdr` (a cube map folder needs px nx py ny pz nz)")))
+        match found.len() {
+            1 => Ok(found.remove(0)),
+            0 => Err(Error::file(dir, format!("has no face `{name}.exr` or `{name}.hdr` (a cube map folder needs px nx py ny pz nz)"))),
+            _ => Err(Error::file(dir, format!("has both `{name}.exr` and `{name}.hdr`; keep one face per direction"))),
+        }
     };
     Ok([find("px")?, find("nx")?, find("py")?, find("ny")?, find("pz")?, find("nz")?])
 }
 
 /// Reads six square, equally sized, power-of-two faces into a one-level cube, each reduced
-/// to `face` wide (if wider) by the cube's solid-angle-weighted 2×2 filter
-/// (`cubemap::downsample_texel`, the same arithmetic as the source cube's mips), one face
-/// at a time.
+/// to `face` wide (if wider) as it is decoded: every output texel is the solid-angle
+/// weighted mean (`cubemap::texel_solid_angle`) of the input texels it covers, summed in
+/// f64, which is what the cube's own 2×2 mip filter (`cubemap::downsample_texel`) gives
+/// applied level after level, rounded once. A face is never held whole.
 pub fn load_faces(paths: &[PathBuf; 6], sanitize: bool, face: u32) -> Result<(Environment, InputReport)> {
     let mut size = 0;
-    let mut all = Vec::new();
-    let mut report = InputReport { sanitized: sanitize, ..Default::default() };
     for p in paths {
         let (w, h) = dimensions(p)?;
         if w != h {
             return Err(Error::file(p, format!("a cube face must be square, this one is {w}×{h}")));
         }
         if w > MAX_FACE {
-            return Err(Error::file(
-                p,
-                format!(
-                    "a cube face may be at most {MAX_FACE}² (each face is read whole, {} MiB at that size), this one is {w}²",
-                    (MAX_FACE as u64).pow(2) * 16 >> 20
-                ),
-            ));
+            return Err(Error::file(p, format!("a cube face may be at most {MAX_FACE}², this one is {w}²")));
         }
         if !w.is_power_of_two() {
             return Err(Error::file(p, format!("a cube face must be a power of two wide, this one is {w}")));
@@ -147,21 +185,17 @@ pub fn load_faces(paths: &[PathBuf; 6], sanitize: bool, face: u32) -> Result<(En
         } else if w != size {
             return Err(Error::file(p, format!("is {w}×{w} but the first face is {size}×{size}")));
         }
-        let (img, r) = read_reduced(p, sanitize, 1)?;
+    }
+    let out = size.min(face.max(1));
+    let mut all = Vec::with_capacity(6 * (out as usize).pow(2));
+    let mut report = InputReport { sanitized: sanitize, ..Default::default() };
+    for p in paths {
+        let (img, r) = read_with(p, Weights::CubeFace, sanitize, size / out)?;
         report.add(&r);
-        let mut texels = img.texels;
-        let mut s = w;
-        while s > face.max(1) {
-            let layout = CubeLayout::new(s, 1);
-            let h = s / 2;
-            texels = (0..h * h).map(|i| cubemap::downsample_texel(&texels, layout, 0, 0, i % h, i / h)).collect();
-            s = h;
-        }
-        all.extend(texels);
+        all.extend(img.texels);
     }
     report.original = (size, size);
-    let size = size.min(face.max(1));
-    Ok((Environment::Cube(Cube { layout: CubeLayout::new(size, 1), texels: all }), report))
+    Ok((Environment::Cube(Cube { layout: CubeLayout::new(out, 1), texels: all }), report))
 }
 
 fn check_equirect_shape(path: &Path, width: u32, height: u32) -> Result<()> {
@@ -196,49 +230,65 @@ fn kind(path: &Path) -> Result<Kind> {
     }
 }
 
-/// Width and height of an `.hdr` or `.exr` image, from its header alone.
+fn file_len(path: &Path) -> Result<u64> {
+    std::fs::metadata(path).map(|m| m.len()).map_err(|e| Error::file(path, format!("cannot read: {e}")))
+}
+
+/// Width and height of an `.hdr` or `.exr` image, from its header alone, checked against
+/// the file's size: a header that promises more blocks or scanlines than the file can hold
+/// is refused here, before anything is allocated for them.
 pub fn dimensions(path: &Path) -> Result<(u32, u32)> {
-    let (w, h) = match kind(path)? {
-        Kind::Exr => {
-            let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| Error::file(path, format!("truncated or malformed OpenEXR: {e}")))?;
-            let header = meta.headers.first().ok_or_else(|| Error::file(path, "malformed OpenEXR: no header"))?;
-            let size = header.layer_size;
-            (size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32)
+    match kind(path)? {
+        Kind::Exr => Ok(exr_header(path, &mut buffered(path)?, file_len(path)?)?.size),
+        Kind::Hdr => {
+            let (w, h) = rgbe::header(path, &mut buffered(path)?)?;
+            check_side(path, w, h)?;
+            check_hdr_length(path, h, file_len(path)?)?;
+            Ok((w, h))
         }
-        Kind::Hdr => rgbe::header(path, &mut buffered(path)?)?,
-    };
-    check_side(path, w, h)?;
-    Ok((w, h))
+    }
 }
 
 fn buffered(path: &Path) -> Result<std::io::BufReader<std::fs::File>> {
     Ok(std::io::BufReader::new(std::fs::File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?))
 }
 
-/// Reads an `.hdr` or `.exr` image as RGBA f32 (alpha 1), row 0 at the top, reduced by
-/// `factor` as an equirect (`Reducer`) and cleaned ([`clean`]'s rules).
+/// Reads an `.hdr` or `.exr` equirect as RGBA f32 (alpha 1), row 0 at the top, reduced by
+/// `factor` ([`Reducer`]) and cleaned ([`clean`]'s rules).
 pub fn read_reduced(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
+    read_with(path, Weights::EquirectRows, sanitize, factor)
+}
+
+/// Reads an `.hdr` or `.exr` image reduced by `factor`, its texels weighted by `weights`.
+fn read_with(path: &Path, weights: Weights, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
     match kind(path)? {
-        Kind::Exr => read_exr(path, buffered(path)?, sanitize, factor),
-        Kind::Hdr => read_hdr(path, sanitize, factor),
+        Kind::Exr => read_exr(path, buffered(path)?, file_len(path)?, weights, sanitize, factor),
+        Kind::Hdr => read_hdr(path, weights, sanitize, factor),
     }
 }
 
+/// Every scanline of a Radiance file takes at least 4 bytes: a header that promises more
+/// rows than the file can hold is refused.
+fn check_hdr_length(path: &Path, h: u32, len: u64) -> Result<()> {
+    if len < 4 * h as u64 {
+        return Err(Error::file(path, format!("truncated Radiance HDR: its header promises {h} scanlines, which take at least {} bytes, but the file has {len}", 4 * h as u64)));
+    }
+    Ok(())
+}
+
 /// A Radiance `.hdr` file, decoded scanline by scanline into a [`Reducer`] ([`rgbe`]).
-fn read_hdr(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
+fn read_hdr(path: &Path, weights: Weights, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
     let mut r = buffered(path)?;
     let (w, h) = rgbe::header(path, &mut r)?;
     check_side(path, w, h)?;
-    // Every scanline takes at least 4 bytes: refuse a header that promises more rows than
-    // the file can hold before allocating for them.
-    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    if len < 4 * h as u64 {
-        return Err(Error::file(path, format!("truncated Radiance HDR: {len} bytes cannot hold {h} scanlines")));
-    }
-    let mut reducer = Reducer::new(w, h, factor, sanitize);
+    check_hdr_length(path, h, file_len(path)?)?;
+    let mut reducer = Reducer::new(w, h, factor, weights, sanitize);
     let mut line = vec![[0u8; 4]; w as usize];
     for y in 0..h {
-        rgbe::scanline(&mut r, &mut line).map_err(|e| Error::file(path, format!("truncated or malformed Radiance HDR (row {y}): {e}")))?;
+        rgbe::scanline(&mut r, &mut line).map_err(|e| {
+            let what = if e.kind() == std::io::ErrorKind::UnexpectedEof { "truncated Radiance HDR: the file ends" } else { "malformed Radiance HDR" };
+            Error::file(path, format!("{what} in scanline {y} of {h}: {e}"))
+        })?;
         for (x, p) in line.iter().enumerate() {
             reducer.push(x as u32, y, rgbe::to_f32(*p));
         }
@@ -258,40 +308,60 @@ mod rgbe {
     use std::io::{BufRead, Read};
     use std::path::Path;
 
-    /// Reads the header and the resolution line: `(width, height)`.
+    /// Reads the header and the resolution line: `(width, height)`. Lines are read as bytes
+    /// (at most 4 KiB each), so pixel data where a line was expected is reported as such.
     pub fn header(path: &Path, r: &mut impl BufRead) -> Result<(u32, u32)> {
         let bad = |why: String| Error::file(path, format!("malformed Radiance HDR: {why}"));
-        let mut line = String::new();
+        let mut line = Vec::new();
+        let read_line = |line: &mut Vec<u8>, r: &mut dyn BufRead| -> Result<usize> {
+            line.clear();
+            let n = r.take(4096).read_until(b'\n', line).map_err(|e| bad(e.to_string()))?;
+            while line.last().is_some_and(|b| *b == b'\n' || *b == b'\r') {
+                line.pop();
+            }
+            Ok(n)
+        };
+        let text = |l: &[u8]| l.iter().all(|b| b.is_ascii_graphic() || *b == b' ' || *b == b'\t');
         let mut first = true;
         loop {
-            line.clear();
-            let n = r.by_ref().take(4096).read_line(&mut line).map_err(|e| bad(e.to_string()))?;
-            if n == 0 {
-                return Err(bad("the header never ends (no empty line)".into()));
+            if read_line(&mut line, r)? == 0 {
+                return Err(bad("the header never ends (no empty line before the resolution line)".into()));
             }
-            let l = line.trim_end_matches(['\n', '\r']);
-            if first && !l.starts_with("#?") {
+            if first && !line.starts_with(b"#?") {
                 return Err(bad("no #? signature".into()));
             }
             first = false;
-            if let Some(format) = l.strip_prefix("FORMAT=") {
+            if line.is_empty() {
+                break;
+            }
+            if !text(&line) {
+                return Err(bad("the header never ends: binary data before the empty line that closes it".into()));
+            }
+            if let Some(format) = line.strip_prefix(b"FORMAT=") {
+                let format = String::from_utf8_lossy(format);
                 if format.trim() != "32-bit_rle_rgbe" {
                     return Err(bad(format!("FORMAT={format} is not supported (only 32-bit_rle_rgbe)")));
                 }
             }
-            if l.is_empty() {
-                break;
-            }
         }
-        line.clear();
-        r.by_ref().take(256).read_line(&mut line).map_err(|e| bad(e.to_string()))?;
-        let f: Vec<&str> = line.split_whitespace().collect();
+        let n = read_line(&mut line, r)?;
+        if n == 0 {
+            return Err(bad("no resolution line after the header (expected `-Y height +X width`)".into()));
+        }
+        if !text(&line) {
+            return Err(bad("no resolution line after the header: pixel data follows it where `-Y height +X width` belongs".into()));
+        }
+        let shown = String::from_utf8_lossy(&line).into_owned();
+        let f: Vec<&str> = shown.split_whitespace().collect();
         match f.as_slice() {
             ["-Y", h, "+X", w] => match (h.parse::<u32>(), w.parse::<u32>()) {
                 (Ok(h), Ok(w)) => Ok((w, h)),
-                _ => Err(bad(format!("unreadable resolution line {:?}", line.trim_end()))),
+                _ => Err(bad(format!("unreadable resolution line {shown:?} (expected `-Y height +X width`)"))),
             },
-            _ => Err(bad(format!("resolution line {:?}: only the standard orientation -Y H +X W is supported", line.trim_end()))),
+            [a, _, b, _] if ["+Y", "-Y", "+X", "-X"].contains(a) && ["+Y", "-Y", "+X", "-X"].contains(b) => {
+                Err(bad(format!("resolution line {shown:?}: only the standard orientation -Y height +X width is supported")))
+            }
+            _ => Err(bad(format!("no resolution line after the header: found {shown:?} where `-Y height +X width` belongs"))),
         }
     }
 
@@ -380,99 +450,179 @@ fn check_side(path: &Path, w: u32, h: u32) -> Result<()> {
     Ok(())
 }
 
-/// An OpenEXR file's R, G, B channels, streamed block by block into a [`Reducer`]; files
-/// without plain `R`, `G`, `B` channels (luminance `Y`, or layer-prefixed names) are read
-/// whole ([`read_exr_channels`]).
-fn read_exr(path: &Path, reader: impl std::io::Read + std::io::Seek, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
-    use exr::prelude::{ReadChannels, ReadLayers, ReadSpecificChannel};
-    let streamed = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .specific_channels()
-        .required("R")
-        .required("G")
-        .required("B")
-        .collect_pixels(
-            |size: exr::math::Vec2<usize>, _: &_| {
-                let (w, h) = (size.width() as u32, size.height() as u32);
-                (w > 0 && h > 0 && w <= MAX_SIDE && h <= MAX_SIDE).then(|| Reducer::new(w, h, factor, sanitize))
-            },
-            |r: &mut Option<Reducer>, pos: exr::math::Vec2<usize>, (red, green, blue): (f32, f32, f32)| {
-                if let Some(r) = r {
-                    r.push(pos.x() as u32, pos.y() as u32, [red, green, blue]);
-                }
-            },
-        )
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(reader);
-    match streamed {
-        Ok(image) => match image.layer_data.channel_data.pixels {
-            Some(reducer) => reducer.finish(path),
-            None => {
-                let size = image.layer_data.size;
-                check_side(path, size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32)?;
-                Err(Error::file(path, "malformed OpenEXR: no pixels"))
-            }
-        },
-        Err(exr::error::Error::Invalid(_)) | Err(exr::error::Error::NotSupported(_)) => read_exr_channels(path, sanitize, factor),
-        Err(e) => Err(Error::file(path, format!("truncated or malformed OpenEXR: {e}"))),
+/// The channels an environment is read from: `R`, `G`, `B` (matched by the last part of
+/// their names, so `diffuse.R` counts), or a luminance `Y` (or `L`) read as grey.
+enum ExrChannels {
+    Rgb([exr::meta::attribute::Text; 3]),
+    Grey(exr::meta::attribute::Text),
+}
+
+/// What splitsum needs of an OpenEXR header.
+struct ExrHeader {
+    size: (u32, u32),
+    channels: ExrChannels,
+}
+
+/// The data window `(x_min, y_min, x_max, y_max)` of the first header, read from its bytes:
+/// the `exr` crate swaps an inverted window's corners without a word, which would read
+/// another image than the file describes. `None` where the header cannot be walked (the
+/// `exr` crate then says why).
+fn exr_raw_data_window(r: &mut impl std::io::BufRead) -> Option<[i32; 4]> {
+    use std::io::Read;
+    let mut head = [0u8; 8];
+    r.read_exact(&mut head).ok()?;
+    let text = |r: &mut dyn std::io::BufRead| -> Option<Vec<u8>> {
+        let mut v = Vec::new();
+        std::io::BufRead::read_until(&mut r.take(256), 0, &mut v).ok()?;
+        (v.pop() == Some(0)).then_some(v)
+    };
+    loop {
+        let name = text(r)?;
+        if name.is_empty() {
+            return None;
+        }
+        let _type = text(r)?;
+        let mut size = [0u8; 4];
+        r.read_exact(&mut size).ok()?;
+        let size = i32::from_le_bytes(size);
+        if name == b"dataWindow" && size == 16 {
+            let mut v = [0u8; 16];
+            r.read_exact(&mut v).ok()?;
+            return Some(std::array::from_fn(|k| i32::from_le_bytes(v[4 * k..4 * k + 4].try_into().expect("4 bytes"))));
+        }
+        if size < 0 || std::io::copy(&mut r.take(size as u64), &mut std::io::sink()).ok()? != size as u64 {
+            return None;
+        }
     }
 }
 
-/// An OpenEXR file read whole, every channel, then R, G, B (matched by the last part of
-/// their names) or Y.
-fn read_exr_channels(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
-    exr_channels(path, buffered(path)?, sanitize, factor)
-}
-
-fn exr_channels(path: &Path, reader: impl std::io::Read + std::io::Seek, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
-    use exr::prelude::{AnyChannel, FlatSamples, ReadChannels, ReadLayers};
-    let image = exr::prelude::read()
-        .no_deep_data()
-        .largest_resolution_level()
-        .all_channels()
-        .first_valid_layer()
-        .all_attributes()
-        .from_buffered(reader)
-        .map_err(|e| Error::file(path, format!("truncated or malformed OpenEXR: {e}")))?;
-    let layer = &image.layer_data;
-    let size = layer.size;
+/// The first OpenEXR header of `reader` (a file of `len` bytes) that holds an image
+/// splitsum reads, checked before anything is allocated for its pixels: a flat (not deep)
+/// image with R, G, B or Y channels at full resolution, a data window that is not inverted,
+/// and no more blocks than the file can hold (each takes at least 16 bytes: its entry in
+/// the offset table and its own header).
+fn exr_header<R: std::io::BufRead + std::io::Seek>(path: &Path, reader: &mut R, len: u64) -> Result<ExrHeader> {
+    let malformed = |why: String| Error::file(path, format!("malformed OpenEXR: {why}"));
+    if let Some([x0, y0, x1, y1]) = exr_raw_data_window(reader) {
+        if x1 < x0 || y1 < y0 {
+            return Err(malformed(format!("its data window is inverted (from ({x0}, {y0}) to ({x1}, {y1}))")));
+        }
+    }
+    reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let meta = exr::meta::MetaData::read_from_buffered(reader, false).map_err(|e| exr_error(path, e))?;
+    let header = meta.headers.iter().find(|h| !h.deep && exr_channels(h).is_some()).ok_or_else(|| {
+        let names: Vec<String> = meta.headers.iter().flat_map(|h| h.channels.list.iter().map(|c| c.name.to_string())).collect();
+        if meta.headers.iter().all(|h| h.deep) { malformed("only deep data, which is not an image".into()) } else { Error::file(path, format!("has no R, G, B (or Y) channels, only {names:?}")) }
+    })?;
+    let size = header.layer_size;
     let (w, h) = (size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32);
     check_side(path, w, h)?;
-    let channel = |names: &[&str]| {
-        layer.channel_data.list.iter().find(|c| {
+    if header.channels.list.iter().any(|c| c.sampling != exr::math::Vec2(1, 1)) {
+        return Err(Error::file(path, "has subsampled channels, which are not supported"));
+    }
+    let chunks: u64 = meta.headers.iter().map(|h| h.chunk_count as u64).sum();
+    if chunks.saturating_mul(16) > len {
+        return Err(Error::file(
+            path,
+            format!("truncated OpenEXR: its header promises {w}×{h} pixels in {chunks} blocks, which take at least {} bytes, but the file has {len}", chunks * 16),
+        ));
+    }
+    Ok(ExrHeader { size: (w, h), channels: exr_channels(header).expect("found above") })
+}
+
+/// The channels of `header` splitsum reads (see [`ExrChannels`]).
+fn exr_channels(header: &exr::meta::header::Header) -> Option<ExrChannels> {
+    let find = |names: &[&str]| {
+        header.channels.list.iter().find(|c| {
             let n = c.name.to_string();
             let base = n.rsplit('.').next().unwrap_or(&n).to_string();
             names.iter().any(|x| base.eq_ignore_ascii_case(x))
         })
     };
-    let n = (w as usize) * (h as usize);
-    let at = |c: &AnyChannel<FlatSamples>, i: usize| -> f32 { c.sample_data.value_by_flat_index(i).to_f32() };
-    let (r, g, b) = match (channel(&["R", "red"]), channel(&["G", "green"]), channel(&["B", "blue"])) {
-        (Some(r), Some(g), Some(b)) => (r, g, b),
-        _ => match channel(&["Y", "L"]) {
-            Some(y) => (y, y, y),
-            None => {
-                let names: Vec<String> = layer.channel_data.list.iter().map(|c| c.name.to_string()).collect();
-                return Err(Error::file(path, format!("has no R, G, B (or Y) channels, only {names:?}")));
-            }
-        },
+    match (find(&["R", "red"]), find(&["G", "green"]), find(&["B", "blue"])) {
+        (Some(r), Some(g), Some(b)) => Some(ExrChannels::Rgb([r.name.clone(), g.name.clone(), b.name.clone()])),
+        _ => find(&["Y", "L"]).map(|y| ExrChannels::Grey(y.name.clone())),
+    }
+}
+
+/// An `exr` crate error in the user's terms.
+fn exr_error(path: &Path, e: exr::error::Error) -> Error {
+    match e {
+        exr::error::Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => Error::file(path, "truncated OpenEXR: the file ends before its last block"),
+        exr::error::Error::Io(io) => Error::file(path, format!("cannot read: {io}")),
+        exr::error::Error::NotSupported(what) => Error::file(path, format!("an OpenEXR feature the exr crate does not read: {what}")),
+        // The offset table points past the end: the file was cut short.
+        exr::error::Error::Invalid(what) if what.contains("missing bytes") => {
+            Error::file(path, format!("truncated OpenEXR: a block lies past the end of the file ({what})"))
+        }
+        exr::error::Error::Invalid(what) => Error::file(path, format!("malformed OpenEXR: {what}")),
+        exr::error::Error::Aborted => Error::file(path, "reading the OpenEXR was aborted"),
+    }
+}
+
+/// An OpenEXR file's R, G, B (or Y) channels, streamed block by block into a [`Reducer`]:
+/// whatever the file, only the reduced image and a few rows of sums are held.
+fn read_exr<R: std::io::BufRead + std::io::Seek>(
+    path: &Path,
+    mut reader: R,
+    len: u64,
+    weights: Weights,
+    sanitize: bool,
+    factor: u32,
+) -> Result<(Equirect, InputReport)> {
+    use exr::prelude::{ReadChannels, ReadLayers, ReadSpecificChannel};
+    let header = exr_header(path, &mut reader, len)?;
+    reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let (w, h) = header.size;
+    let new = |size: exr::math::Vec2<usize>| (size.width() == w as usize && size.height() == h as usize).then(|| Reducer::new(w, h, factor, weights, sanitize));
+    let pixels = match header.channels {
+        ExrChannels::Rgb([r, g, b]) => exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .specific_channels()
+            .required(r)
+            .required(g)
+            .required(b)
+            .collect_pixels(
+                |size: exr::math::Vec2<usize>, _: &_| new(size),
+                |red: &mut Option<Reducer>, pos: exr::math::Vec2<usize>, (r, g, b): (f32, f32, f32)| {
+                    if let Some(red) = red {
+                        red.push(pos.x() as u32, pos.y() as u32, [r, g, b]);
+                    }
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(reader)
+            .map(|image| image.layer_data.channel_data.pixels),
+        ExrChannels::Grey(y) => exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .specific_channels()
+            .required(y)
+            .collect_pixels(
+                |size: exr::math::Vec2<usize>, _: &_| new(size),
+                |red: &mut Option<Reducer>, pos: exr::math::Vec2<usize>, (y,): (f32,)| {
+                    if let Some(red) = red {
+                        red.push(pos.x() as u32, pos.y() as u32, [y, y, y]);
+                    }
+                },
+            )
+            .first_valid_layer()
+            .all_attributes()
+            .from_buffered(reader)
+            .map(|image| image.layer_data.channel_data.pixels),
     };
-    if [r, g, b].iter().any(|c| c.sample_data.len() != n) {
-        return Err(Error::file(path, "channels are subsampled, which is not supported"));
+    match pixels.map_err(|e| exr_error(path, e))? {
+        Some(reducer) => reducer.finish(path),
+        None => Err(Error::file(path, "malformed OpenEXR: its layers disagree about the image's size")),
     }
-    let mut reducer = Reducer::new(w, h, factor, sanitize);
-    for i in 0..n {
-        reducer.push((i % w as usize) as u32, (i / w as usize) as u32, [at(r, i), at(g, i), at(b, i)]);
-    }
-    reducer.finish(path)
 }
 
 /// Counts and fixes negative values, and refuses or sanitises NaN and ∞ (see the module
 /// documentation), in place. Alpha is set to 1.
 pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputReport> {
-    let mut reducer = Reducer::new(texels.len() as u32, 1, 1, sanitize);
+    let mut reducer = Reducer::new(texels.len() as u32, 1, 1, Weights::EquirectRows, sanitize);
     for (i, t) in texels.iter().enumerate() {
         reducer.push(i as u32, 0, [t.x, t.y, t.z]);
     }
@@ -481,50 +631,85 @@ pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputRe
     Ok(report)
 }
 
-/// An equirect image received pixel by pixel, in any order (an EXR's blocks may arrive
-/// out of order), cleaned as it comes (the module documentation's rules) and reduced by
-/// `factor` in both axes: each output texel is the solid-angle-weighted mean
-/// (`equirect::row_solid_angle`) of the `factor²` input texels it covers, summed in f64.
-/// Only the output rows still being filled hold f64 sums, so memory is the output image
-/// plus a few rows, whatever the input's size. At factor 1 nothing is summed and no weight
-/// plays a part: texels are only cleaned (a plain list of texels, a cube face).
+/// How the input texels that one output texel covers are weighted.
+#[derive(Copy, Clone, Debug)]
+enum Weights {
+    /// By the solid angle of their equirect row (`equirect::row_solid_angle`).
+    EquirectRows,
+    /// By their solid angle on a cube face (`cubemap::texel_solid_angle`).
+    CubeFace,
+}
+
+/// An image received pixel by pixel, in any order (an EXR's blocks may arrive out of
+/// order), cleaned as it comes (the module documentation's rules) and reduced by `factor`
+/// in both axes: each output texel is the mean of the `factor²` input texels it covers,
+/// weighted by their solid angle ([`Weights`]) and summed in f64. Only the output rows
+/// still being filled hold sums, so memory is the output image plus a few rows, whatever
+/// the input's size or however much of it a file really holds. At factor 1 nothing is
+/// summed and no weight plays a part: texels are only cleaned.
 struct Reducer {
     width: u32,
     height: u32,
     factor: u32,
+    weights: Weights,
     sanitize: bool,
     out: Vec<Vec4>,
-    /// f64 sums (r, g, b) of the output rows being filled.
+    /// f64 sums (r, g, b, weight) of the output rows being filled.
     pending: Vec<Option<Box<[f64]>>>,
     /// Input texels received per output row.
     arrived: Vec<u32>,
-    /// Solid angle of each input row (empty at factor 1, where nothing is summed).
+    /// Solid angle of each input row (equirects reduced by more than 1 only).
     row_weight: Vec<f64>,
-    /// (output texel, channels that are +∞ (bit k), weight, already counted as clamped) of
-    /// each input with a +∞ channel: replaced by the channel's largest finite value when the
-    /// image is complete (and counted as clamped if that value is).
-    infinite: Vec<(u32, u8, f64, bool)>,
+    /// Per output texel, the weight of its inputs that were +∞ in each channel (made only
+    /// when a +∞ arrives): replaced by the channel's largest finite value when the image
+    /// is complete.
+    infinite: Vec<[f64; 3]>,
+    /// Texels with a +∞ channel and no other clamped value, by which channels are +∞ (bit
+    /// k): counted as clamped at the end if such a channel's largest value is.
+    infinite_masks: [u64; 8],
     channel_max: [f32; 3],
     report: InputReport,
 }
 
 impl Reducer {
-    fn new(width: u32, height: u32, factor: u32, sanitize: bool) -> Self {
+    fn new(width: u32, height: u32, factor: u32, weights: Weights, sanitize: bool) -> Self {
         let factor = if width % factor == 0 && height % factor == 0 { factor.max(1) } else { 1 };
         let (ow, oh) = (width / factor, height / factor);
-        let row_weight = if factor > 1 { (0..height).map(|y| equirect::row_solid_angle(y, height) as f64).collect() } else { Vec::new() };
+        let rows = factor > 1 && matches!(weights, Weights::EquirectRows);
+        let row_weight = if rows { (0..height).map(|y| equirect::row_solid_angle(y, height) as f64).collect() } else { Vec::new() };
         Self {
             width,
             height,
             factor,
+            weights,
             sanitize,
             out: vec![Vec4::ZERO; ow as usize * oh as usize],
             pending: (0..oh).map(|_| None).collect(),
             arrived: vec![0; oh as usize],
             row_weight,
             infinite: Vec::new(),
+            infinite_masks: [0; 8],
             channel_max: [0.0; 3],
             report: InputReport { sanitized: sanitize, original: (width, height), ..Default::default() },
+        }
+    }
+
+    /// The weight of input texel `(x, y)`.
+    fn weight(&self, x: u32, y: u32) -> f64 {
+        match self.weights {
+            _ if self.factor == 1 => 1.0,
+            Weights::EquirectRows => self.row_weight[y as usize],
+            Weights::CubeFace => cubemap::texel_solid_angle(x, y, self.width) as f64,
+        }
+    }
+
+    /// The total weight of output texel `(ox, oy)`'s inputs.
+    fn block_weight(&self, ox: usize, oy: usize) -> f64 {
+        let f = self.factor as usize;
+        match self.weights {
+            _ if f == 1 => 1.0,
+            Weights::EquirectRows => self.row_weight[oy * f..(oy + 1) * f].iter().sum::<f64>() * f as f64,
+            Weights::CubeFace => (0..f * f).map(|k| self.weight((ox * f + k % f) as u32, (oy * f + k / f) as u32)).sum(),
         }
     }
 
@@ -563,18 +748,27 @@ impl Reducer {
         }
         self.report.negative += negative as u64;
         self.report.clamped += clamped as u64;
-        let w = if f == 1 { 1.0 } else { self.row_weight[y as usize] };
-        let mask = (infinite[0] as u8) | (infinite[1] as u8) << 1 | (infinite[2] as u8) << 2;
+        let w = self.weight(x, y);
+        let mask = (infinite[0] as usize) | (infinite[1] as usize) << 1 | (infinite[2] as usize) << 2;
         if mask != 0 {
-            self.infinite.push(((oy * ow + ox) as u32, mask, w, clamped));
+            if self.infinite.is_empty() {
+                self.infinite = vec![[0.0; 3]; self.out.len()];
+            }
+            for k in (0..3).filter(|k| infinite[*k]) {
+                self.infinite[oy * ow + ox][k] += w;
+            }
+            if !clamped {
+                self.infinite_masks[mask] += 1;
+            }
         }
         if f == 1 {
             self.out[oy * ow + ox] = Vec4::new(c[0], c[1], c[2], 1.0);
         } else {
-            let row = self.pending[oy].get_or_insert_with(|| vec![0.0; 3 * ow].into_boxed_slice());
+            let row = self.pending[oy].get_or_insert_with(|| vec![0.0; 4 * ow].into_boxed_slice());
             for k in 0..3 {
-                row[3 * ox + k] += c[k] as f64 * w;
+                row[4 * ox + k] += c[k] as f64 * w;
             }
+            row[4 * ox + 3] += w;
         }
         self.arrived[oy] += 1;
         if f > 1 && self.arrived[oy] == f * self.width {
@@ -582,18 +776,12 @@ impl Reducer {
         }
     }
 
-    /// The total weight of one output texel of row `oy`.
-    fn texel_weight(&self, oy: usize) -> f64 {
-        let f = self.factor as usize;
-        self.row_weight[oy * f..(oy + 1) * f].iter().sum::<f64>() * f as f64
-    }
-
     fn resolve_row(&mut self, oy: usize) {
         let ow = (self.width / self.factor) as usize;
-        let total = self.texel_weight(oy);
         if let Some(row) = self.pending[oy].take() {
             for ox in 0..ow {
-                let m = |k: usize| (row[3 * ox + k] / total) as f32;
+                let w = row[4 * ox + 3];
+                let m = |k: usize| if w > 0.0 { (row[4 * ox + k] / w) as f32 } else { 0.0 };
                 self.out[oy * ow + ox] = Vec4::new(m(0), m(1), m(2), 1.0);
             }
         }
@@ -606,22 +794,24 @@ impl Reducer {
         let (ow, oh) = (self.width / self.factor, self.height / self.factor);
         for oy in 0..oh as usize {
             if self.pending[oy].is_some() {
-                // Texels never received (a truncated block) count as black.
+                // Rows of a file that held fewer texels than its header promised.
                 self.resolve_row(oy);
             }
         }
-        let f = self.factor as usize;
-        for &(texel, mask, w, counted) in &self.infinite {
-            let oy = texel as usize / ow as usize;
-            let share = if f == 1 { 1.0 } else { w / self.texel_weight(oy) };
-            let mut clamped = false;
-            for k in (0..3).filter(|k| mask & (1 << k) != 0) {
-                clamped |= self.channel_max[k] > MAX_RADIANCE;
+        let infinite = std::mem::take(&mut self.infinite);
+        for (texel, weights) in infinite.iter().enumerate().filter(|(_, w)| w.iter().any(|&v| v > 0.0)) {
+            let (ox, oy) = (texel % ow as usize, texel / ow as usize);
+            let total = self.block_weight(ox, oy);
+            for k in 0..3 {
                 let max = self.channel_max[k].min(MAX_RADIANCE);
-                let t = &mut self.out[texel as usize];
-                t[k] = (t[k] as f64 + max as f64 * share) as f32;
+                let t = &mut self.out[texel];
+                t[k] = (t[k] as f64 + max as f64 * weights[k] / total) as f32;
             }
-            self.report.clamped += (clamped && !counted) as u64;
+        }
+        for (mask, &count) in self.infinite_masks.iter().enumerate() {
+            if (0..3).any(|k| mask & (1 << k) != 0 && self.channel_max[k] > MAX_RADIANCE) {
+                self.report.clamped += count;
+            }
         }
         self.report.max_value = self.channel_max.iter().copied().fold(0.0, f32::max);
         Ok((Equirect { width: ow, height: oh, texels: self.out }, self.report))
@@ -635,7 +825,7 @@ pub static EMBEDDED_DEFAULT: &[u8] = include_bytes!("../../assets/environments/c
 /// Decodes [`EMBEDDED_DEFAULT`].
 pub fn embedded_default() -> Result<Environment> {
     let path = Path::new("<embedded courtyard.exr>");
-    let (image, _) = exr_channels(path, std::io::Cursor::new(EMBEDDED_DEFAULT), false, 1)?;
+    let (image, _) = read_exr(path, std::io::Cursor::new(EMBEDDED_DEFAULT), EMBEDDED_DEFAULT.len() as u64, Weights::EquirectRows, false, 1)?;
     Ok(Environment::Equirect(image))
 }
 

@@ -27,12 +27,120 @@ pub fn check_writable(path: &Path) -> Result<()> {
         Ok(_) => return Err(Error::file(path, format!("cannot write here: {} is a file, not a folder", dir.display()))),
         Err(e) => return Err(Error::file(path, format!("cannot write here: folder {}: {e}", dir.display()))),
     }
-    // Probe with a temporary file: permissions and read-only file systems show up now,
-    // not after a long bake.
-    let probe = dir.join(format!(".splitsum-probe.{}.tmp", std::process::id()));
-    File::create(&probe).map_err(|e| Error::file(path, format!("cannot write here: {e}")))?;
+    // Probe with a temporary file of a name nobody has (created new, never opened if it
+    // exists): permissions and read-only file systems show up now, not after a long bake.
+    let (probe, _) = create_new_sibling(&dir.join(".splitsum-probe")).map_err(|e| Error::file(path, format!("cannot write here: {e}")))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
+}
+
+/// The kind of a single-file output: what splitsum writes under a name, and the only kind
+/// of existing file it replaces.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum FileKind {
+    /// OpenEXR.
+    Exr,
+    /// PNG.
+    Png,
+    /// JPEG.
+    Jpeg,
+}
+
+impl FileKind {
+    /// The kind's name, as a message says it.
+    pub fn name(self) -> &'static str {
+        match self {
+            FileKind::Exr => "OpenEXR",
+            FileKind::Png => "PNG",
+            FileKind::Jpeg => "JPEG",
+        }
+    }
+
+    /// The file-name extensions of the kind (lower case).
+    pub fn extensions(self) -> &'static [&'static str] {
+        match self {
+            FileKind::Exr => &["exr"],
+            FileKind::Png => &["png"],
+            FileKind::Jpeg => &["jpg", "jpeg"],
+        }
+    }
+
+    /// The kind whose signature `head` (a file's first bytes) starts with.
+    pub fn of_signature(head: &[u8]) -> Option<FileKind> {
+        match head {
+            [0x76, 0x2f, 0x31, 0x01, ..] => Some(FileKind::Exr),
+            [0x89, b'P', b'N', b'G', ..] => Some(FileKind::Png),
+            [0xFF, 0xD8, 0xFF, ..] => Some(FileKind::Jpeg),
+            _ => None,
+        }
+    }
+
+    /// The picture kind `path`'s extension names (PNG or JPEG); `called` is what the caller
+    /// calls the path (a flag, a field), for the message.
+    pub fn picture(path: &Path, called: &str) -> Result<FileKind> {
+        let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase()).unwrap_or_default();
+        [FileKind::Png, FileKind::Jpeg]
+            .into_iter()
+            .find(|k| k.extensions().contains(&ext.as_str()))
+            .ok_or_else(|| Error::Invalid(format!("{called} {}: name a .png or .jpg file (the format follows the extension)", path.display())))
+    }
+
+    /// The `image` crate's format of a picture kind.
+    fn image_format(self) -> image::ImageFormat {
+        match self {
+            FileKind::Exr => image::ImageFormat::OpenExr,
+            FileKind::Png => image::ImageFormat::Png,
+            FileKind::Jpeg => image::ImageFormat::Jpeg,
+        }
+    }
+}
+
+/// Checks, before any work, that a file of `kind` may be written at `path` (`called`: what
+/// the caller calls it, a flag or a field): its name has the kind's extension, it is not a
+/// folder or a symbolic link, an existing file there is of the same kind (splitsum never
+/// replaces a file of another kind), and its folder takes files ([`check_writable`]).
+pub fn check_output_file(path: &Path, kind: FileKind, called: &str) -> Result<()> {
+    let shown = path.display();
+    let ext = path.extension().map(|e| e.to_string_lossy().to_lowercase()).unwrap_or_default();
+    if !kind.extensions().contains(&ext.as_str()) && !path.is_dir() {
+        return Err(Error::Invalid(format!("{called} {shown}: this file is written as {}; name it .{}", kind.name(), kind.extensions()[0])));
+    }
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => {
+            return Err(Error::Invalid(format!("{called} {shown} is a symbolic link; name the file itself (splitsum replaces a file, never a link)")));
+        }
+        Ok(m) if m.is_dir() => return Err(Error::Invalid(format!("{called} {shown} is a folder; name a .{} file", kind.extensions()[0]))),
+        Ok(m) if !m.is_file() => return Err(Error::Invalid(format!("{called} {shown} exists and is not a regular file; name another file"))),
+        Ok(_) => {
+            let mut head = [0u8; 8];
+            let n = std::fs::File::open(path).and_then(|mut f| std::io::Read::read(&mut f, &mut head)).map_err(|e| Error::file(path, format!("cannot read the existing file: {e}")))?;
+            let found = FileKind::of_signature(&head[..n]);
+            if found != Some(kind) {
+                let what = found.map_or_else(|| "not".to_string(), |k| format!("an {} file, not", k.name()));
+                return Err(Error::Invalid(format!(
+                    "{called} {shown} exists and is {what} a {} file; splitsum replaces only a file of the kind it writes: move it away or name another file",
+                    kind.name()
+                )));
+            }
+        }
+        Err(_) => {}
+    }
+    check_writable(path)
+}
+
+/// Creates a new file beside `base` named `base` plus a suffix no file there has yet (the
+/// process id, then a counter), never opening an existing file.
+fn create_new_sibling(base: &Path) -> std::io::Result<(PathBuf, File)> {
+    let name = base.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    for k in 0..1000u32 {
+        let p = parent_dir(base).join(format!("{name}.{}.{k}.tmp", std::process::id()));
+        match std::fs::OpenOptions::new().write(true).create_new(true).open(&p) {
+            Ok(f) => return Ok((p, f)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        }
+    }
+    Err(std::io::Error::other("no free temporary file name"))
 }
 
 fn parent_dir(path: &Path) -> PathBuf {
@@ -42,14 +150,10 @@ fn parent_dir(path: &Path) -> PathBuf {
     }
 }
 
-fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    parent_dir(path).join(format!(".{name}.{}.tmp", std::process::id()))
-}
-
-/// Writes `path` through `write` into a temporary sibling, then renames it into place.
+/// Writes `path` through `write` into a new temporary sibling, then renames it into place.
 pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> std::io::Result<()>) -> Result<()> {
-    let tmp = temp_path(path);
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let mut tmp = None;
     let result = (|| {
         // Every change to a folder's entries happens under the interrupt lock: an interrupt
         // that removes a staging folder holds it until the process exits, so nothing is
@@ -57,17 +161,21 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> std
         let file = {
             let _interrupt = PENDING.lock().unwrap_or_else(|e| e.into_inner());
             std::fs::create_dir_all(parent_dir(path))?;
-            File::create(&tmp)?
+            let (p, f) = create_new_sibling(&parent_dir(path).join(format!(".{name}")))?;
+            tmp = Some(p);
+            f
         };
         let mut w = BufWriter::new(file);
         write(&mut w)?;
         w.flush()?;
         w.into_inner().map_err(|e| e.into_error())?.sync_all()?;
         let _interrupt = PENDING.lock().unwrap_or_else(|e| e.into_inner());
-        std::fs::rename(&tmp, path)
+        std::fs::rename(tmp.as_ref().expect("created"), path)
     })();
     result.map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
+        if let Some(t) = &tmp {
+            let _ = std::fs::remove_file(t);
+        }
         Error::file(path, format!("could not write: {e}"))
     })
 }
@@ -96,27 +204,18 @@ pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
 
 /// Writes an 8-bit RGB PNG from row-major `rgb` (values already in [0, 255]).
 pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()> {
-    write_rgb8(path, width, height, rgb, image::ImageFormat::Png)
+    write_rgb8(path, width, height, rgb, FileKind::Png)
 }
 
-/// The 8-bit format the name of `path` asks for: PNG or JPEG. `called` is what the caller
-/// calls the path (a flag, a field), for the message.
-pub fn picture_format(path: &Path, called: &str) -> Result<image::ImageFormat> {
-    match image::ImageFormat::from_path(path) {
-        Ok(f @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => Ok(f),
-        _ => Err(Error::Invalid(format!("{called} {}: name a .png or .jpg file (the format follows the extension)", path.display()))),
-    }
-}
-
-/// Writes an 8-bit RGB image from row-major `rgb` in `format` (PNG, or JPEG at quality 95).
-pub fn write_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8], format: image::ImageFormat) -> Result<()> {
+/// Writes an 8-bit RGB image from row-major `rgb` as `kind` (PNG, or JPEG at quality 95).
+pub fn write_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8], kind: FileKind) -> Result<()> {
     let img = image::RgbImage::from_raw(width, height, rgb.to_vec()).ok_or_else(|| Error::file(path, "image buffer has the wrong size"))?;
     write_atomic(path, |w| {
         let mut buf = std::io::Cursor::new(Vec::new());
-        if format == image::ImageFormat::Jpeg {
+        if kind == FileKind::Jpeg {
             image::codecs::jpeg::JpegEncoder::new_with_quality(&mut buf, 95).encode_image(&img).map_err(std::io::Error::other)?;
         } else {
-            img.write_to(&mut buf, format).map_err(std::io::Error::other)?;
+            img.write_to(&mut buf, kind.image_format()).map_err(std::io::Error::other)?;
         }
         w.write_all(buf.get_ref())
     })
@@ -167,13 +266,170 @@ pub fn write_cube_level_exr(path: &Path, cube: &crate::texture::Cube, level: u32
     )
 }
 
-/// Names of the manifests splitsum writes into an output folder: a folder holding one of
-/// them is a previous output, which a new run may replace whole.
-pub const MANIFESTS: [&str; 3] = ["bake.json", "plan.json", "report.md"];
+/// The manifest in every output folder splitsum writes as a unit ([`OutputDir`]): every
+/// entry it wrote there, files with their size and BLAKE3 hash. A folder may be replaced
+/// only when everything in it is listed there, unchanged ([`check_replaceable`]).
+pub const OUTPUT_MANIFEST: &str = ".splitsum-manifest.json";
+
+/// Format of [`OUTPUT_MANIFEST`].
+const MANIFEST_FORMAT: &str = "splitsum-output-1";
+
+/// The largest manifest read (a folder of 10⁵ entries); a larger file is not one of ours.
+const MAX_MANIFEST_BYTES: u64 = 16 << 20;
+
+#[derive(serde::Serialize, serde::Deserialize)]
+struct OutputManifest {
+    format: String,
+    /// Every entry below the folder, `/`-separated, in sorted order.
+    entries: Vec<ManifestEntry>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+struct ManifestEntry {
+    path: String,
+    /// `None` for a folder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    file: Option<FileStamp>,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+struct FileStamp {
+    bytes: u64,
+    blake3: String,
+}
+
+/// An entry found below a folder: its `/`-separated path and what it is.
+enum Found {
+    Folder(String),
+    File(String, u64),
+    /// A symbolic link, device, socket…: never something splitsum writes.
+    Other(String),
+}
+
+/// Every entry below `dir` except the root's manifest, in sorted order, without following
+/// symbolic links.
+fn walk(dir: &Path) -> std::io::Result<Vec<Found>> {
+    fn visit(dir: &Path, prefix: &str, out: &mut Vec<Found>) -> std::io::Result<()> {
+        let mut entries: Vec<_> = std::fs::read_dir(dir)?.collect::<std::io::Result<_>>()?;
+        entries.sort_by_key(|e| e.file_name());
+        for e in entries {
+            let name = e.file_name().to_string_lossy().into_owned();
+            if prefix.is_empty() && name == OUTPUT_MANIFEST {
+                continue;
+            }
+            let rel = format!("{prefix}{name}");
+            let t = e.file_type()?;
+            if t.is_dir() {
+                out.push(Found::Folder(rel.clone()));
+                visit(&e.path(), &format!("{rel}/"), out)?;
+            } else if t.is_file() {
+                out.push(Found::File(rel, e.metadata()?.len()));
+            } else {
+                out.push(Found::Other(rel));
+            }
+        }
+        Ok(())
+    }
+    let mut out = Vec::new();
+    visit(dir, "", &mut out)?;
+    Ok(out)
+}
+
+fn hash_file(path: &Path) -> std::io::Result<String> {
+    let mut h = blake3::Hasher::new();
+    h.update_reader(File::open(path)?)?;
+    Ok(h.finalize().to_hex().to_string())
+}
+
+/// The manifest of everything below `dir` (all of it written by this run).
+fn manifest_of(dir: &Path) -> std::io::Result<OutputManifest> {
+    let mut entries = Vec::new();
+    for f in walk(dir)? {
+        entries.push(match f {
+            Found::Folder(path) => ManifestEntry { path, file: None },
+            Found::File(path, bytes) => {
+                let blake3 = hash_file(&dir.join(&path))?;
+                ManifestEntry { path, file: Some(FileStamp { bytes, blake3 }) }
+            }
+            Found::Other(path) => return Err(std::io::Error::other(format!("{path} is neither a file nor a folder"))),
+        });
+    }
+    Ok(OutputManifest { format: MANIFEST_FORMAT.into(), entries })
+}
+
+/// The manifest `dir` holds, if it holds a readable one of splitsum's.
+fn read_manifest(dir: &Path) -> Option<OutputManifest> {
+    let path = dir.join(OUTPUT_MANIFEST);
+    let m = std::fs::symlink_metadata(&path).ok()?;
+    if !m.is_file() || m.len() > MAX_MANIFEST_BYTES {
+        return None;
+    }
+    let manifest: OutputManifest = serde_json::from_slice(&std::fs::read(&path).ok()?).ok()?;
+    (manifest.format == MANIFEST_FORMAT).then_some(manifest)
+}
+
+/// Checks that the existing folder `dir` may be replaced whole: every entry below it is
+/// listed in its [`OUTPUT_MANIFEST`] and every file there is as splitsum wrote it (size
+/// and BLAKE3 hash). Otherwise the error names the first entry splitsum did not write, or
+/// the first it wrote that has changed since; `called` is what the caller calls the folder
+/// (a flag, a field). An empty folder may be replaced.
+pub fn check_replaceable(dir: &Path, called: &str) -> Result<()> {
+    let shown = dir.display();
+    let found = walk(dir).map_err(|e| Error::file(dir, format!("cannot read the output folder: {e}")))?;
+    if found.is_empty() {
+        return Ok(());
+    }
+    let manifest = read_manifest(dir);
+    let listed = |path: &str| manifest.as_ref().and_then(|m| m.entries.iter().find(|e| e.path == path));
+    let refuse = |entry: &str, why: &str| {
+        Err(Error::Invalid(format!(
+            "{called} {shown} holds {entry}, {why}; splitsum replaces an output folder only when everything in it is what splitsum wrote there (listed, unchanged, in its {OUTPUT_MANIFEST}): move {entry} away, or give a new or empty folder"
+        )))
+    };
+    for f in &found {
+        match f {
+            Found::Other(path) => return refuse(path, "which is neither a file nor a folder splitsum wrote"),
+            Found::Folder(path) => match listed(path) {
+                Some(ManifestEntry { file: None, .. }) => {}
+                _ => return refuse(path, "a folder splitsum did not write"),
+            },
+            Found::File(path, bytes) => match listed(path).and_then(|e| e.file.as_ref()) {
+                None => return refuse(path, "which splitsum did not write"),
+                Some(stamp) => {
+                    let same = stamp.bytes == *bytes && hash_file(&dir.join(path)).is_ok_and(|h| h == stamp.blake3);
+                    if !same {
+                        return refuse(path, "which has changed since splitsum wrote it");
+                    }
+                }
+            },
+        }
+    }
+    Ok(())
+}
+
+/// Removes, from the folder `dir` that [`check_replaceable`] passed, what its manifest
+/// lists (files, then folders from the deepest), the manifest and `dir` itself; an entry
+/// that is not listed (one that appeared since the check) stays, with the folders above
+/// it. Returns whether `dir` is gone.
+fn remove_written(dir: &Path) -> bool {
+    if let Some(m) = read_manifest(dir) {
+        for e in m.entries.iter().filter(|e| e.file.is_some()) {
+            let p = dir.join(&e.path);
+            if std::fs::symlink_metadata(&p).is_ok_and(|m| m.is_file()) {
+                let _ = std::fs::remove_file(p);
+            }
+        }
+        for e in m.entries.iter().rev().filter(|e| e.file.is_none()) {
+            let _ = std::fs::remove_dir(dir.join(&e.path));
+        }
+        let _ = std::fs::remove_file(dir.join(OUTPUT_MANIFEST));
+    }
+    std::fs::remove_dir(dir).is_ok()
+}
 
 /// Staging folders not yet committed, and the folders created for them: removed if the
 /// process is interrupted (SIGINT, SIGTERM, SIGHUP), under this lock, which a commit holds
-/// while it swaps folders.
+/// while it swaps folders and removes the old one.
 static PENDING: std::sync::Mutex<Vec<(PathBuf, Vec<PathBuf>)>> = std::sync::Mutex::new(Vec::new());
 
 /// Makes SIGINT, SIGTERM and SIGHUP remove every uncommitted staging folder (and the
@@ -199,13 +455,16 @@ pub fn remove_staging_on_interrupt() {
 }
 
 /// An output folder written as a unit: every file goes into a hidden staging folder beside
-/// it, and [`OutputDir::commit`] swaps the staging folder and the old folder in one
-/// `renameat2(RENAME_EXCHANGE)` (Linux; elsewhere two renames), then removes the old one. A
-/// reader sees the whole old set of files or the whole new set, never a mix; a failure
-/// before the commit leaves the old folder as it was, no staging folder and no folder this
-/// run created, and so does an interruption once [`remove_staging_on_interrupt`] is on.
+/// it, and [`OutputDir::commit`] lists them in the folder's [`OUTPUT_MANIFEST`], swaps the
+/// staging folder and the old folder in one `renameat2(RENAME_EXCHANGE)` (Linux; elsewhere
+/// two renames), then removes what the old folder's manifest lists. A reader sees the
+/// whole old set of files or the whole new set, never a mix; a failure before the commit
+/// leaves the old folder as it was, no staging folder and no folder this run created, and
+/// so does an interruption once [`remove_staging_on_interrupt`] is on. A folder holding
+/// anything splitsum did not write is never replaced ([`check_replaceable`]).
 pub struct OutputDir {
     target: PathBuf,
+    called: String,
     staging: PathBuf,
     created: Vec<PathBuf>,
     committed: bool,
@@ -213,29 +472,17 @@ pub struct OutputDir {
 
 impl OutputDir {
     /// Starts writing the folder `target`; `called` is what the caller calls it (a flag, a
-    /// field), for messages. Refuses a path
-    /// that is a file, and a folder holding files that no splitsum run wrote (it would be
-    /// replaced whole).
+    /// field), for messages. Refuses a path that is a file or a symbolic link, and a folder
+    /// holding anything splitsum did not write there ([`check_replaceable`]): it would be
+    /// replaced whole.
     pub fn begin(target: &Path, called: &str) -> Result<Self> {
         let shown = target.display();
-        match std::fs::metadata(target) {
-            Ok(m) if !m.is_dir() => return Err(Error::Invalid(format!("{called} {shown} is an existing file; give a folder (it is created if missing)"))),
-            Ok(_) => {
-                let entries: Vec<String> = std::fs::read_dir(target)
-                    .map_err(|e| Error::file(target, format!("cannot read the output folder: {e}")))?
-                    .filter_map(|e| e.ok().map(|e| e.file_name().to_string_lossy().into_owned()))
-                    .collect();
-                if !entries.is_empty() && !entries.iter().any(|e| MANIFESTS.contains(&e.as_str())) {
-                    let mut some = entries.clone();
-                    some.sort();
-                    some.truncate(3);
-                    return Err(Error::Invalid(format!(
-                        "{called} {shown} holds files splitsum did not write ({}{}); the output folder is replaced as a whole, so give a new or empty folder",
-                        some.join(", "),
-                        if entries.len() > 3 { ", …" } else { "" }
-                    )));
-                }
+        match std::fs::symlink_metadata(target) {
+            Ok(m) if m.file_type().is_symlink() => {
+                return Err(Error::Invalid(format!("{called} {shown} is a symbolic link; give the folder itself (the output folder is replaced as a whole)")));
             }
+            Ok(m) if !m.is_dir() => return Err(Error::Invalid(format!("{called} {shown} is an existing file; give a folder (it is created if missing)"))),
+            Ok(_) => check_replaceable(target, called)?,
             Err(_) => {}
         }
         let name = target.file_name().filter(|n| *n != "." && *n != "..").ok_or_else(|| {
@@ -256,19 +503,21 @@ impl OutputDir {
         let staging = parent.join(format!(".{}.splitsum-{}", name.to_string_lossy(), std::process::id()));
         {
             let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
-            let made = std::fs::create_dir_all(&parent).and_then(|_| {
-                let _ = std::fs::remove_dir_all(&staging);
-                std::fs::create_dir(&staging)
-            });
+            let made = std::fs::create_dir_all(&parent).and_then(|_| std::fs::create_dir(&staging));
             if let Err(e) = made {
                 for d in created.iter().rev() {
                     let _ = std::fs::remove_dir(d);
                 }
-                return Err(Error::file(target, format!("cannot create the output folder: {e}")));
+                let why = if e.kind() == std::io::ErrorKind::AlreadyExists {
+                    format!("{} is in the way (a staging folder of another run with this process id?); remove it", staging.display())
+                } else {
+                    e.to_string()
+                };
+                return Err(Error::file(target, format!("cannot create the output folder: {why}")));
             }
             pending.push((staging.clone(), created.clone()));
         }
-        Ok(Self { target: target.to_path_buf(), staging, created, committed: false })
+        Ok(Self { target: target.to_path_buf(), called: called.to_string(), staging, created, committed: false })
     }
 
     /// The folder to write into (the staging folder).
@@ -281,20 +530,44 @@ impl OutputDir {
         &self.target
     }
 
-    /// Makes the staged files the output folder, replacing the old one whole.
+    /// Makes the staged files the output folder, replacing the old one whole: the staged
+    /// entries are listed in the manifest, the old folder is checked again (it may have
+    /// changed while the run worked), the two are swapped, and what the old manifest lists
+    /// is removed. Should an entry have appeared in the old folder between the check and the
+    /// swap, that folder is kept beside the new one and a note says where.
     pub fn commit(mut self) -> Result<()> {
-        let mut pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+        let manifest = manifest_of(&self.staging).map_err(|e| Error::file(&self.target, format!("cannot list the output files: {e}")))?;
+        let json = serde_json::to_vec_pretty(&manifest).expect("serialisable");
+        write_atomic(&self.staging.join(OUTPUT_MANIFEST), |w| w.write_all(&json))?;
+        let pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
+        let existed = match std::fs::symlink_metadata(&self.target) {
+            Ok(m) if m.is_dir() && !m.file_type().is_symlink() => {
+                check_replaceable(&self.target, &self.called)?;
+                true
+            }
+            Ok(_) => return Err(Error::Invalid(format!("{} {} is no longer a folder; nothing was replaced", self.called, self.target.display()))),
+            Err(_) => false,
+        };
         sync_dir(&self.staging);
-        let swapped = if self.target.exists() { exchange(&self.staging, &self.target) } else { std::fs::rename(&self.staging, &self.target) };
+        let swapped = if existed { exchange(&self.staging, &self.target) } else { std::fs::rename(&self.staging, &self.target) };
         swapped.map_err(|e| Error::file(&self.target, format!("could not replace the output folder: {e}")))?;
         sync_dir(&parent_dir(&self.target));
-        // The staging path now holds the old set (or nothing): still removed if interrupted.
-        if let Some(entry) = pending.iter_mut().find(|(s, _)| *s == self.staging) {
-            entry.1.clear();
+        self.committed = true;
+        // The staging path now holds the old set (or nothing).
+        if existed && !remove_written(&self.staging) {
+            let kept = self.staging.with_file_name(format!(
+                "{}.kept",
+                self.staging.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default()
+            ));
+            let at = if std::fs::rename(&self.staging, &kept).is_ok() { kept } else { self.staging.clone() };
+            crate::progress::note(&format!(
+                "note: entries appeared in {} {} while this run worked: the old folder, with them, is kept at {}",
+                self.called,
+                self.target.display(),
+                at.display()
+            ));
         }
         drop(pending);
-        self.committed = true;
-        let _ = std::fs::remove_dir_all(&self.staging);
         PENDING.lock().unwrap_or_else(|e| e.into_inner()).retain(|(s, _)| *s != self.staging);
         Ok(())
     }

@@ -28,6 +28,7 @@
 
 #![warn(missing_docs)]
 
+pub mod adjustment;
 pub mod backend;
 pub mod bake;
 pub mod cache;

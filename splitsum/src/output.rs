@@ -49,6 +49,9 @@ pub struct Manifest {
     pub accuracy: &'static str,
     /// What reading the environment found.
     pub input: InputSummary,
+    /// What the bake changed from what it was given (an input reduced or upsampled, a
+    /// sample count capped, texels cleaned), each also stated when it ran.
+    pub adjustments: Vec<crate::adjustment::Adjustment>,
     /// Wall time per product.
     pub timings: Vec<Timing>,
     /// How far SH9 irradiance is from the convolution, over the irradiance cube's texels.
@@ -106,11 +109,20 @@ pub struct InputSummary {
     pub infinite_texels: u64,
     /// Largest finite value.
     pub max_value: f32,
+    /// Width and height of the file (of one face, for a cube).
+    pub file_size: (u32, u32),
 }
 
 impl From<&InputReport> for InputSummary {
     fn from(r: &InputReport) -> Self {
-        Self { negative_texels: r.negative, clamped_texels: r.clamped, nan_texels: r.nan, infinite_texels: r.infinite, max_value: r.max_value }
+        Self {
+            negative_texels: r.negative,
+            clamped_texels: r.clamped,
+            nan_texels: r.nan,
+            infinite_texels: r.infinite,
+            max_value: r.max_value,
+            file_size: r.original,
+        }
     }
 }
 

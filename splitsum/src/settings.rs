@@ -2,6 +2,7 @@
 //! the one validation), [`Products`] (which products) and [`Target`] (whose conventions
 //! the files follow).
 
+use crate::adjustment::Adjustment;
 use crate::error::{Error, Result};
 use crate::ktx2::Format;
 use serde::{Deserialize, Serialize};
@@ -222,6 +223,10 @@ impl Default for Settings {
 /// Largest cube face accepted.
 pub const MAX_SIZE: u32 = 4096;
 
+/// The most GGX samples a texel of one specular mip takes (2²⁰): beyond it a sampled mip's
+/// error is far below the half float it is stored in.
+pub const MAX_SAMPLES: u32 = 1 << 20;
+
 /// Largest BRDF table accepted (a 4096² table is 128 MiB; beyond that nothing gains).
 pub const MAX_LUT_SIZE: u32 = 4096;
 
@@ -243,8 +248,8 @@ impl Settings {
         if self.mips == 0 || self.mips > max_mips {
             return Err(Error::setting("mips", format!("must be from 1 to {max_mips} for {0}² faces, not {1}", self.size, self.mips)));
         }
-        if self.samples == 0 {
-            return Err(Error::setting("samples", "must be at least 1, not 0"));
+        if self.samples == 0 || self.samples > MAX_SAMPLES {
+            return Err(Error::setting("samples", format!("must be from 1 to {MAX_SAMPLES} (the most a mip takes), not {}", self.samples)));
         }
         if !(1..=4).contains(&self.sample_growth) {
             return Err(Error::setting("sample_growth", format!("must be from 1 to 4, not {}", self.sample_growth)));
@@ -347,7 +352,58 @@ impl Settings {
     /// GGX samples of each specular mip: `samples × sample_growth^(m−1)` from mip 1 on
     /// (mip 0 is the mirror unless the mapping says otherwise), at most 2²⁰.
     pub fn samples_per_mip(&self) -> Vec<u32> {
-        (0..self.mips).map(|m| (self.samples as u64 * (self.sample_growth as u64).pow(m.saturating_sub(1))).min(1 << 20) as u32).collect()
+        self.asked_samples_per_mip().into_iter().map(|n| n.min(MAX_SAMPLES as u64) as u32).collect()
+    }
+
+    /// `samples × sample_growth^(m−1)` per mip, before the cap.
+    fn asked_samples_per_mip(&self) -> Vec<u64> {
+        (0..self.mips).map(|m| (self.samples as u64).saturating_mul((self.sample_growth as u64).saturating_pow(m.saturating_sub(1)))).collect()
+    }
+
+    /// The fields a bake of `products` with these settings does not read (`cube_input`: from
+    /// six faces, which are not resampled), each with why: a value given for one of them
+    /// would change nothing, so a caller that was given one refuses it by name.
+    pub fn unread(&self, products: Products, cube_input: bool) -> Vec<(&'static str, Unread)> {
+        let mut out = Vec::new();
+        let mut add = |fields: &[&'static str], why: Unread| out.extend(fields.iter().map(|f| (*f, why)));
+        if !products.lut {
+            add(&["lut_size", "lut_method", "lut_masking", "lut_samples"], Unread::NoTable);
+        } else if self.lut_method == TableMethod::Quadrature {
+            add(&["lut_samples"], Unread::QuadratureTable);
+        }
+        if !products.irradiance {
+            add(&["irradiance_size", "irradiance_source"], Unread::NoIrradiance);
+        }
+        if !products.sh9 {
+            add(&["sh_source"], Unread::NoSh9);
+        }
+        if cube_input {
+            add(&["supersample_density"], Unread::CubeInput);
+        }
+        if !products.specular || self.mips == 1 {
+            add(&["samples", "sample_growth", "lod_bias", "exact_sums"], Unread::MirrorOnly);
+        } else if self.mips == 2 {
+            add(&["sample_growth"], Unread::NoGrowth);
+        }
+        out
+    }
+
+    /// What a bake of `env` with these settings changes from what they ask: a mip's sample
+    /// count capped at [`MAX_SAMPLES`], a source cube finer than the environment resolves.
+    pub fn adjustments(&self, env: &crate::environment::Environment) -> Vec<Adjustment> {
+        let mut out = Vec::new();
+        for (mip, (asked, used)) in self.asked_samples_per_mip().into_iter().zip(self.samples_per_mip()).enumerate() {
+            if mip > 0 && asked > used as u64 && self.mapping.roughness(mip as u32, self.mips) > 0.0 {
+                out.push(Adjustment::SamplesCapped { mip: mip as u32, asked, used });
+            }
+        }
+        if let crate::environment::Environment::Equirect(e) = env {
+            let resolves = env.resolves();
+            if self.source_size > resolves {
+                out.push(Adjustment::Upsampled { width: e.width, height: e.height, resolves, source_size: self.source_size });
+            }
+        }
+        out
     }
 
     /// Every mip of the specular cube: `0 .. mips`.
@@ -370,6 +426,41 @@ pub fn exact_levels(roughness: &[f32], samples: &[u32], exact: bool, src: CubeLa
 /// The source level whose faces are `face` wide (or the smallest there is).
 pub fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
     (0..layout.levels).find(|&l| layout.level_size(l) <= face).unwrap_or(layout.levels - 1)
+}
+
+/// Why a bake does not read a setting ([`Settings::unread`]).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Unread {
+    /// The table is integrated by quadrature, which takes no sample count.
+    QuadratureTable,
+    /// No BRDF table is baked.
+    NoTable,
+    /// No irradiance cube is baked.
+    NoIrradiance,
+    /// No SH9 is baked.
+    NoSh9,
+    /// The input is a cube: nothing is resampled.
+    CubeInput,
+    /// The specular cube has only the mirror mip (or none), which takes no samples.
+    MirrorOnly,
+    /// With two mips, no mip after mip 1 grows its sample count.
+    NoGrowth,
+}
+
+impl Unread {
+    /// Why, naming settings through `term` (as [`Adjustment::describe`]) and the target.
+    pub fn describe(self, target: Target, term: &dyn Fn(&'static str) -> String) -> String {
+        let by = |what: &str| if target == Target::Splitsum { format!("this bake makes no {what}") } else { format!("the {} target makes no {what}", target.name()) };
+        match self {
+            Unread::QuadratureTable => format!("the quadrature table takes no sample count (only {} sampled does)", term("lut_method")),
+            Unread::NoTable => by("BRDF table"),
+            Unread::NoIrradiance => by("irradiance cube"),
+            Unread::NoSh9 => by("SH9 coefficients"),
+            Unread::CubeInput => "a cube map is read as it is, not resampled".into(),
+            Unread::MirrorOnly => format!("with {} 1 the specular cube is the mirror alone, which takes no samples", term("mips")),
+            Unread::NoGrowth => format!("with {} 2 no mip after mip 1 grows its sample count", term("mips")),
+        }
+    }
 }
 
 /// Which products to bake.

@@ -27,7 +27,9 @@ pub(super) struct BakeArgs {
 
 pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
     if let Some(scene_path) = &args.scene.scene {
-        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        if args.env.is_some() {
+            return Err(Usage::new("give either ENV or --scene, not both (the scene names its environment)").into());
+        }
         refuse_beside_scene(given, &SCENE_FLAGS)?;
         let out = files::OutputDir::begin(&args.out, "--out")?;
         let backend = Backend::open(args.backend)?;
@@ -39,6 +41,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let env_path = args.env.clone().expect("clap requires ENV without --scene");
     let settings = args.quality.settings();
     settings.validate()?;
+    refuse_unread(given, &settings, settings.target.products(), env_path.is_dir())?;
     let out = files::OutputDir::begin(&args.out, "--out")?;
     let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
     let backend = Backend::open(args.backend)?;
@@ -46,6 +49,10 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let products = settings.target.products();
     bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, products, &settings.all_levels()), args.scene.force)?;
     println!("baking {} on {} for {}", env_path.display(), backend.describe(), settings.target.name());
+    let changed = settings.adjustments(&env);
+    for a in &changed {
+        eprintln!("note: {}", a.describe(&flag_of));
+    }
     let baked = bake::bake(&backend, &env, &settings, products)?;
     let manifest = output::Manifest {
         environment: env_path.display().to_string(),
@@ -55,6 +62,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
         samples_per_mip: settings.samples_per_mip(),
         accuracy: output::DEFAULTS_ACCURACY,
         input: (&input).into(),
+        adjustments: input.adjustments(&env).into_iter().chain(changed).collect(),
         timings: Vec::new(),
         sh9_vs_convolution: None,
         files: Vec::new(),

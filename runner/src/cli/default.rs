@@ -50,7 +50,7 @@ pub(super) fn default_run() -> anyhow::Result<()> {
     };
     let (w, h) = (960, 540);
     let out = PathBuf::from("splitsum.png");
-    files::check_writable(&out)?;
+    files::check_output_file(&out, files::FileKind::Png, "the picture")?;
     let pixels = match &backend {
         Backend::Gpu(g) => {
             let scene = crate::render::GpuScene::new(g, &baked);

@@ -31,18 +31,21 @@ pub(super) struct LutArgs {
     force: bool,
 }
 
-pub(super) fn lut(args: LutArgs) -> anyhow::Result<()> {
-    files::check_writable(&args.out)?;
+pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
+    if args.method != TableMethod::Sampled && given.iter().any(|f| f == "--samples") {
+        return Err(Usage::new("--samples sets the sampled table's count; the quadrature table (--method quadrature, the default) takes none: drop --samples, or add --method sampled").into());
+    }
+    files::check_output_file(&args.out, files::FileKind::Exr, "--out")?;
     let png = args.png.then(|| args.out.with_extension("png"));
     if let Some(p) = &png {
-        files::check_writable(p)?;
+        files::check_output_file(p, files::FileKind::Png, "--png (the preview beside --out)")?;
     }
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();
     let masking = args.masking.unwrap_or(args.method.default_masking());
     let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: masking, ..Settings::default() };
     if settings.lut_method == TableMethod::Sampled && settings.lut_masking != Masking::SmithSchlick {
-        anyhow::bail!("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)");
+        return Err(Usage::new("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)").into());
     }
     // The table is the cost model's third step (`plan::STEPS[2]`); a table needs no source cube.
     let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };

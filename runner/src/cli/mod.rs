@@ -381,6 +381,40 @@ const SETTING_FLAGS: [(&str, &str); 19] = [
 const STEP_FLAGS: [&str; 4] =
     ["--source-size and --supersample", "--samples, --sample-growth and --size", "--lut-size and --lut-samples", "--irradiance-size and --irradiance-source"];
 
+/// A request refused as written: a flag, its value, flags that contradict each other, the
+/// target or the scene, a scene file's fields, an output path that may not be replaced, a
+/// bake estimated over an hour without `--force`. Nothing was done. The process exits with
+/// [`USAGE_EXIT`], as for clap's own errors; see [`exit_code`].
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Usage(String);
+
+impl Usage {
+    /// A refused request, in the user's terms.
+    pub fn new(message: impl Into<String>) -> Self {
+        Self(message.into())
+    }
+}
+
+/// Exit status of a request refused as written ([`Usage`], clap's errors).
+pub const USAGE_EXIT: i32 = 2;
+/// Exit status of work that failed: an input that cannot be read or decoded, no GPU, a
+/// device error, a full disk.
+pub const FAILURE_EXIT: i32 = 1;
+
+/// The one exit-code rule: [`USAGE_EXIT`] for a request refused as written (before any
+/// work: nothing was written), [`FAILURE_EXIT`] for work that failed; 130 after an
+/// interruption (`files::remove_staging_on_interrupt`); 0 on success.
+pub fn exit_code(e: &anyhow::Error) -> i32 {
+    if e.downcast_ref::<Usage>().is_some() || e.downcast_ref::<clap::Error>().is_some() {
+        return USAGE_EXIT;
+    }
+    match e.downcast_ref::<splitsum::Error>() {
+        Some(splitsum::Error::Setting { .. } | splitsum::Error::Invalid(_) | splitsum::Error::TooLong { .. }) => USAGE_EXIT,
+        _ => FAILURE_EXIT,
+    }
+}
+
 /// A library error in the user's terms: a setting by the flag that sets it (`flags`: field
 /// to flag, beside [`SETTING_FLAGS`]), a refused long bake with the flags that set its cost
 /// and `--force`, unreadable texels with `--sanitize`.
@@ -388,16 +422,34 @@ pub(crate) fn in_flags(e: splitsum::Error, flags: &[(&str, &str)], step_flags: &
     match e {
         splitsum::Error::Setting { field, problem } => {
             let flag = flags.iter().chain(SETTING_FLAGS.iter()).find(|(f, _)| *f == field).map_or(field, |(_, flag)| flag);
-            anyhow::anyhow!("{flag} {problem}")
+            Usage::new(format!("{flag} {problem}")).into()
         }
         splitsum::Error::TooLong { step, .. } => {
             let k = crate::cost::STEPS.iter().position(|s| *s == step).unwrap_or(0);
-            anyhow::anyhow!("{e}; lower {} (scene: [quality]), or pass --force to run it anyway", step_flags[k])
+            Usage::new(format!("{e}; lower {} (scene: [quality]), or pass --force to run it anyway", step_flags[k])).into()
         }
+        splitsum::Error::Invalid(m) => Usage::new(m).into(),
         splitsum::Error::NonFinite { .. } => anyhow::anyhow!("{e}: pass --sanitize to do so"),
         splitsum::Error::NoAdapter { .. } => anyhow::anyhow!("{e}\n  (`--backend cpu` bakes on the CPU)"),
         e => e.into(),
     }
+}
+
+/// Refuses, by name, a flag in `given` that sets a setting this bake does not read
+/// (`Settings::unread`): it would change nothing.
+fn refuse_unread(given: &[String], settings: &Settings, products: Products, cube_input: bool) -> anyhow::Result<()> {
+    for (field, why) in settings.unread(products, cube_input) {
+        let flag = flag_of(field);
+        if given.contains(&flag) {
+            return Err(Usage::new(format!("{flag} has no effect here: {}; drop it", why.describe(settings.target, &flag_of))).into());
+        }
+    }
+    Ok(())
+}
+
+/// The flag that sets field `field` of `Settings` (or `--FIELD`), for messages.
+pub(crate) fn flag_of(field: &'static str) -> String {
+    SETTING_FLAGS.iter().find(|(f, _)| *f == field).map_or_else(|| format!("--{}", field.replace('_', "-")), |(_, flag)| flag.to_string())
 }
 
 /// [`in_flags`] for a bake's flags.
@@ -409,11 +461,13 @@ pub(crate) fn bake_error(e: splitsum::Error) -> anyhow::Error {
 /// other flag in `given`, naming them and the scene tables that set them.
 fn refuse_beside_scene(given: &[String], allowed: &[&str]) -> anyhow::Result<()> {
     let extra: Vec<&str> = given.iter().map(String::as_str).filter(|f| !allowed.contains(f) && *f != "--scene" && *f != "--env").collect();
-    anyhow::ensure!(
-        extra.is_empty(),
-        "with --scene, the scene file sets the environment, [quality], [camera], [output] and the materials: drop {} (or edit the scene)",
-        extra.join(", ")
-    );
+    if !extra.is_empty() {
+        return Err(Usage::new(format!(
+            "with --scene, the scene file sets the environment, [quality], [camera], [output] and the materials: drop {} (or edit the scene)",
+            extra.join(", ")
+        ))
+        .into());
+    }
     Ok(())
 }
 
@@ -448,7 +502,7 @@ where
         })
         .unwrap_or_default();
     let result = match cli.command {
-        Some(Command::Lut(args)) => lut::lut(args),
+        Some(Command::Lut(args)) => lut::lut(args, &given),
         Some(Command::Bake(args)) => bake::bake_command(args, &given),
         Some(Command::Bench(args)) => bench::bench(args),
         Some(Command::Render(args)) => render::render(args, &given),
@@ -480,25 +534,8 @@ pub fn load_input(path: &std::path::Path, sanitize: bool, face: u32) -> anyhow::
         let _step = crate::progress::step(&format!("reading {}", path.display()), None);
         environment::load_for(path, sanitize, face)?
     };
-    let p = path.display();
-    if input.negative > 0 {
-        eprintln!("note: {p}: {} texels had negative values, set to 0", input.negative);
-    }
-    if input.clamped > 0 {
-        eprintln!("note: {p}: {} texels were brighter than 1e20 and were clamped to it", input.clamped);
-    }
-    if input.sanitized && (input.nan > 0 || input.infinite > 0) {
-        eprintln!("note: {p}: replaced {} NaN and {} infinite texels (--sanitize)", input.nan, input.infinite);
-    }
-    let (w, h) = input.original;
-    match &env {
-        environment::Environment::Equirect(e) if e.width < w => {
-            eprintln!("note: {p}: {w}×{h} read as {}×{} (area-weighted): a cube of {face}² faces resolves no more (--source-size)", e.width, e.height)
-        }
-        environment::Environment::Cube(c) if c.layout.size < w => {
-            eprintln!("note: {p}: faces of {w}² read as {}² (the cube's own mip filter): the bake uses no more (--source-size)", c.layout.size)
-        }
-        _ => {}
+    for a in input.adjustments(&env) {
+        eprintln!("note: {}: {}", path.display(), a.describe(&flag_of));
     }
     Ok((env, input))
 }

@@ -28,10 +28,12 @@ pub(super) struct RenderArgs {
 }
 
 pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
-    let format = files::picture_format(&args.out, "--out")?;
-    files::check_writable(&args.out)?;
+    let format = files::FileKind::picture(&args.out, "--out")?;
+    files::check_output_file(&args.out, format, "--out")?;
     if let Some(scene_path) = &args.scene.scene {
-        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        if args.env.is_some() {
+            return Err(Usage::new("give either ENV or --scene, not both (the scene names its environment)").into());
+        }
         refuse_beside_scene(given, &SCENE_FLAGS)?;
         let backend = Backend::open(args.backend)?;
         let (scene, sb) = args.scene.bake(scene_path, &backend)?;
@@ -49,15 +51,19 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
         return Ok(());
     }
     crate::render::check_size(args.width, args.height)?;
+    // The model first: a model that cannot be read costs no bake.
+    let model = args.look.load_model()?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(args.backend)?;
     let settings = args.bake.settings(&env);
+    for a in settings.adjustments(&env) {
+        eprintln!("note: {}", a.describe(&flag_of));
+    }
     bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::DISPLAY, &settings.all_levels()), args.scene.force)?;
     let start = Instant::now();
     let baked = bake::bake_for_display(&backend, &env, &settings)?;
     let bake_secs = start.elapsed().as_secs_f64();
     let view = args.look.view(baked.auto_exposure());
-    let model = args.look.load_model()?;
     let start = Instant::now();
     let frame = view.frame(baked.shape(), args.width, args.height, true);
     let pixels = {

@@ -26,7 +26,9 @@ pub(super) struct ViewArgs {
 
 pub(super) fn view(args: ViewArgs, given: &[String]) -> anyhow::Result<()> {
     if args.scene.scene.is_some() {
-        anyhow::ensure!(args.env.is_none(), "give either ENV or --scene, not both (the scene names its environment)");
+        if args.env.is_some() {
+            return Err(Usage::new("give either ENV or --scene, not both (the scene names its environment)").into());
+        }
         refuse_beside_scene(given, &["--force", "--cache", "--calibration", "--exit-after"])?;
     }
     if !crate::view::display_available() {
@@ -47,16 +49,20 @@ pub(super) fn view(args: ViewArgs, given: &[String]) -> anyhow::Result<()> {
         return Ok(());
     }
     crate::render::check_size(args.width, args.height)?;
+    // The model first: a model that cannot be read costs no bake.
+    let model = args.look.load_model()?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(BackendKind::Gpu)?;
     let settings = args.bake.settings(&env);
+    for a in settings.adjustments(&env) {
+        eprintln!("note: {}", a.describe(&flag_of));
+    }
     bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::DISPLAY, &settings.all_levels()), args.scene.force)?;
     let start = Instant::now();
     let baked = bake::bake_for_display(&backend, &env, &settings)?;
     println!("{name} baked on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
     let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
     let state = args.look.view(baked.auto_exposure());
-    let model = args.look.load_model()?;
     let options = crate::view::ViewOptions {
         exit_after: args.exit_after.map(std::time::Duration::from_secs_f64),
         exit_after_frames: None,
