@@ -335,6 +335,22 @@ fn the_cache_reuses_unchanged_bakes_and_rebuilds_bad_entries() {
     std::fs::create_dir_all(dir.join(&first.key)).unwrap();
     assert!(matches!(cache.get(&first.key), Lookup::Rejected(why) if why.contains("manifest")));
     assert!(matches!(cache.get(&first.key), Lookup::Miss), "a rejected entry is removed");
+
+    // An entry that also holds a file the cache did not write is never removed: the bake
+    // fails, naming it, and the file stays.
+    bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap();
+    std::fs::write(entry_file(&dir, &first.key, "specular.bin"), b"corrupt").unwrap();
+    std::fs::write(entry_file(&dir, &first.key, "notes.txt"), b"mine").unwrap();
+    let e = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).err().expect("a foreign file in the entry").to_string();
+    assert!(e.contains("notes.txt") && e.contains("did not write"), "{e}");
+    assert_eq!(std::fs::read(entry_file(&dir, &first.key, "notes.txt")).unwrap(), b"mine");
+    // A manifest that claims a product far larger than its file: refused by size, unread.
+    std::fs::remove_file(entry_file(&dir, &first.key, "notes.txt")).unwrap();
+    let manifest = entry_file(&dir, &first.key, "manifest.json");
+    let mut m: serde_json::Value = serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
+    m["files"]["specular.bin"]["bytes"] = serde_json::json!(1u64 << 40);
+    std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
+    assert!(matches!(cache.get(&first.key), Lookup::Rejected(why) if why.contains("specular.bin is corrupt (it holds 7 bytes")));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -128,8 +128,14 @@ impl App {
 
     fn screenshot(&mut self) {
         let (w, h) = self.config.as_ref().map(|c| (c.width, c.height)).unwrap_or((960, 540));
-        self.screenshots += 1;
-        let path = PathBuf::from(format!("splitsum-screenshot-{}.png", self.screenshots));
+        // The next name no file has: a screenshot never replaces a file.
+        let path = loop {
+            self.screenshots += 1;
+            let p = PathBuf::from(format!("splitsum-screenshot-{}.png", self.screenshots));
+            if std::fs::symlink_metadata(&p).is_err() {
+                break p;
+            }
+        };
         let frame = self.state.frame(self.scene.shape, w, h, true);
         let result = self
             .scene

@@ -408,7 +408,14 @@ fn hostile_headers_stay_within_memory_bounds() {
         std::fs::write(&lying, &bytes).unwrap();
         patch_box(&lying, "dataWindow", [0, 0, 32767, 16383]);
         patch_box(&lying, "displayWindow", [0, 0, 32767, 16383]);
-        cases.push((format!("{c:?} lying about its size"), lying, "OpenEXR"));
+        cases.push((format!("{c:?} lying about its size"), lying.clone(), "OpenEXR"));
+        // The same, padded so that its blocks' offsets fit in the file: the blocks it
+        // reads are garbage, and nothing beyond what the file holds is decoded.
+        let padded = d.join(format!("c{k}-padded.exr"));
+        let mut b = std::fs::read(&lying).unwrap();
+        b.resize(b.len() + (300 << 10), 0);
+        std::fs::write(&padded, b).unwrap();
+        cases.push((format!("{c:?} lying, padded to its block count"), padded, "OpenEXR"));
     }
     // A header claiming every compression code over the same lying size.
     for code in 0..10u8 {
@@ -435,6 +442,23 @@ fn hostile_headers_stay_within_memory_bounds() {
     b.extend(std::iter::repeat_n([2u8, 2, 128, 0], 20000).flatten());
     std::fs::write(&hdr, &b).unwrap();
     cases.push(("hdr lying about its size".into(), hdr, "Radiance HDR"));
+    // 1000 valid run-length scanlines of 16384 pixels (the widest run-length coding takes
+    // is 32767) under a header promising 8192.
+    let hdr = d.join("short.hdr");
+    let mut b = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8192 +X 16384\n".to_vec();
+    let mut line = vec![2u8, 2, 64, 0];
+    for _ in 0..4 {
+        // 129 runs of 127 and one of 1: 16384 values of one channel.
+        for _ in 0..129 {
+            line.extend_from_slice(&[128 + 127, 100]);
+        }
+        line.extend_from_slice(&[128 + 1, 100]);
+    }
+    for _ in 0..1000 {
+        b.extend_from_slice(&line);
+    }
+    std::fs::write(&hdr, &b).unwrap();
+    cases.push(("hdr cut short after 1000 valid scanlines".into(), hdr, "the file ends in scanline 1000 of 8192"));
     let no_res = d.join("nores.hdr");
     let mut b = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n".to_vec();
     b.extend((0..4096u32).map(|i| (i * 37 % 251) as u8 | 0x80));
@@ -510,6 +534,29 @@ fn hostile_headers_stay_within_memory_bounds() {
         assert!(said.contains(message), "{what}: expected {message:?} in: {said}");
         assert!(peak <= bound, "{what}: peak {peak} bytes > bound {bound}: {said}");
     }
+    // A cache entry whose specular product is a 1 GiB (sparse) file, as its manifest says,
+    // but not the bake it claims: its hash is streamed, it is never held, and the scene
+    // is baked again within what the first bake took.
+    let scene = format!("{}/../scenes/brushed-metal.toml", env!("CARGO_MANIFEST_DIR"));
+    let cache = d.join("cache");
+    let scene_bake = || {
+        let mut c = runner();
+        c.args(["bake", "--scene", &scene, "--backend", "cpu", "--cache", cache.to_str().unwrap(), "--out", d.join("scene-out").to_str().unwrap()]);
+        c
+    };
+    let (ok, said, scene_baseline) = run_measured(scene_bake(), &d);
+    assert!(ok, "{said}");
+    let entry = std::fs::read_dir(&cache).unwrap().map(|e| e.unwrap().path()).find(|p| p.is_dir()).unwrap();
+    let big = std::fs::File::create(entry.join("specular.bin")).unwrap();
+    big.set_len(1 << 30).unwrap();
+    let manifest = entry.join("manifest.json");
+    let mut m: serde_json::Value = serde_json::from_slice(&std::fs::read(&manifest).unwrap()).unwrap();
+    m["files"]["specular.bin"]["bytes"] = serde_json::json!(1u64 << 30);
+    std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
+    let (ok, said, peak) = run_measured(scene_bake(), &d);
+    eprintln!("cache entry of 1 GiB: peak {:.1} MiB (first bake {:.1} MiB): {}", peak as f64 / 1048576.0, scene_baseline as f64 / 1048576.0, said.lines().last().unwrap_or(""));
+    assert!(ok && said.contains("rejected (specular.bin is corrupt (its BLAKE3 hash differs"), "{said}");
+    assert!(peak <= (64 << 20) + scene_baseline, "peak {peak}");
     for (what, input, message) in &cases {
         let len = std::fs::metadata(input).map(|m| if m.is_dir() { 6 * 16 << 10 } else { m.len() }).unwrap();
         let (ok, said, peak) = run_measured(bake(input), &d);
@@ -565,4 +612,344 @@ fn crc32(bytes: &[u8]) -> u32 {
         }
     }
     !c
+}
+
+/// Runs `runner args…` to its end: (exit code, stdout and stderr).
+fn run_code(args: &[&str]) -> (i32, String) {
+    let o = runner().args(args).output().unwrap();
+    (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
+}
+
+/// Every file below `dir` with its bytes, in sorted order.
+fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                out.push((p.clone(), Vec::new()));
+                stack.push(p);
+            } else {
+                out.push((p.clone(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// The cases a new user met (issue 19), each with the message that names the real problem
+/// and the one exit-code rule: 2 for a request refused as written, 1 for work that failed.
+/// A folder of the user's files is never replaced, by any command; a bake whose settings
+/// change what was asked says so and records it in `bake.json`; a successful GPU run
+/// without `XDG_RUNTIME_DIR` prints no error line.
+#[test]
+fn each_case_names_the_real_problem_with_one_exit_code_rule() {
+    let d = scratch("cases");
+    let dir = |name: &str| d.join(name).to_str().unwrap().to_string();
+    let env = courtyard();
+    // A project folder of the user's, with a file named like a splitsum output.
+    let proj = d.join("proj");
+    std::fs::create_dir_all(proj.join("figs")).unwrap();
+    std::fs::write(proj.join("thesis.tex"), "\\documentclass{article}").unwrap();
+    std::fs::write(proj.join("figs/plot.pdf"), "%PDF").unwrap();
+    std::fs::write(proj.join("plan.json"), "{}").unwrap();
+    let before = snapshot(&proj);
+    let scene = format!("{}/../scenes/brushed-metal.toml", env!("CARGO_MANIFEST_DIR"));
+    let cache = dir("cache");
+    for args in [
+        vec!["bake", &env, "--backend", "cpu", "--size", "16", "--out"],
+        vec!["bake", &env, "--backend", "cpu", "--size", "16", "--target", "khronos", "--out"],
+        vec!["bake", "--scene", &scene, "--backend", "cpu", "--cache", &cache, "--out"],
+        vec!["report", "--quick", "--backends", "cpu", "--out"],
+    ] {
+        let mut args = args.clone();
+        let p = dir("proj");
+        args.push(&p);
+        let (code, said) = run_code(&args);
+        assert_eq!(code, 2, "{args:?}: {said}");
+        assert!(said.contains("--out") && said.contains("holds figs, a folder splitsum did not write"), "{args:?}: {said}");
+        assert_eq!(snapshot(&proj), before, "{args:?} touched the user's folder");
+    }
+    // A splitsum output to which the user added a file, or whose file the user changed.
+    let out = dir("out");
+    assert_eq!(run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", &out]).0, 0);
+    std::fs::write(d.join("out/notes.txt"), "mine").unwrap();
+    let (code, said) = run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", &out]);
+    assert!(code == 2 && said.contains("holds notes.txt, which splitsum did not write"), "{said}");
+    std::fs::remove_file(d.join("out/notes.txt")).unwrap();
+    std::fs::write(d.join("out/bake.json"), "{\"edited\": true}").unwrap();
+    let (code, said) = run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", &out]);
+    assert!(code == 2 && said.contains("holds bake.json, which has changed since splitsum wrote it"), "{said}");
+    assert_eq!(std::fs::read_to_string(d.join("out/bake.json")).unwrap(), "{\"edited\": true}");
+    // Single files: never another kind, never under the wrong extension.
+    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--png", "--out", &dir("t.png")]);
+    assert!(code == 2 && said.contains("--out") && said.contains("name it .exr"), "{said}");
+    std::fs::write(d.join("mine.exr"), "not an EXR").unwrap();
+    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--out", &dir("mine.exr")]);
+    assert!(code == 2 && said.contains("exists and is not a OpenEXR file"), "{said}");
+    assert_eq!(std::fs::read(d.join("mine.exr")).unwrap(), b"not an EXR");
+    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--png", "--out", &dir("t.exr")]);
+    assert!(code == 0 && said.matches("wrote").count() == 2 && said.contains("t.exr") && said.contains("t.png"), "{said}");
+    // Nothing silent: a flag the path ignores is refused, a cap or an upsampling is stated.
+    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--samples", "64", "--out", &dir("u.exr")]);
+    assert!(code == 2 && said.contains("--samples") && said.contains("--method sampled"), "{said}");
+    let (code, said) = run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--lut-samples", "64", "--out", &dir("x")]);
+    assert!(code == 2 && said.contains("--lut-samples has no effect here"), "{said}");
+    let (code, said) = run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--target", "filament", "--lut-size", "64", "--out", &dir("x")]);
+    assert!(code == 2 && said.contains("--lut-size has no effect here: the filament target makes no BRDF table"), "{said}");
+    let (code, said) = run_code(&["bake", &env, "--samples", "4294967295", "--out", &dir("x")]);
+    assert!(code == 2 && said.contains("--samples must be from 1 to 1048576"), "{said}");
+    let small = d.join("small.exr");
+    write_equirect(&small, 512, 10.0);
+    let adjustments = |out: &str| -> Vec<String> {
+        let json: serde_json::Value = serde_json::from_slice(&std::fs::read(Path::new(out).join("bake.json")).unwrap()).unwrap();
+        json["adjustments"].as_array().unwrap().iter().map(|a| a["kind"].as_str().unwrap().to_string()).collect()
+    };
+    let up = dir("upsampled");
+    let (code, said) = run_code(&["bake", small.to_str().unwrap(), "--backend", "cpu", "--out", &up]);
+    assert_eq!(code, 0, "{said}");
+    assert!(said.contains("512×256 resolves about 128² per cube face; the 256² source cube (--source-size) interpolates it 2×"), "{said}");
+    assert_eq!(adjustments(&up), ["upsampled"]);
+    // 2²⁰ samples at mip 1 of 2² faces, doubling: mip 2 would take 2²¹ (mip 3, r = 1, is summed exactly).
+    let capped = dir("capped");
+    let (code, said) = run_code(&[
+        "bake", small.to_str().unwrap(), "--backend", "cpu", "--size", "4", "--source-size", "8", "--mips", "3", "--sampled-only", "--samples", "1048576", "--force", "--out", &capped,
+    ]);
+    assert_eq!(code, 0, "{said}");
+    assert!(said.contains("mip 2 takes 1048576 GGX samples per texel, not the 2097152 that --samples × --sample-growth^1 asks for"), "{said}");
+    assert_eq!(adjustments(&capped), ["reduced", "samples_capped"]);
+    // Messages that point the right way.
+    let faces = d.join("faces");
+    std::fs::create_dir_all(faces.join("py.exr")).unwrap();
+    for name in ["px", "nx", "ny", "pz", "nz"] {
+        use exr::prelude::*;
+        let ch = SpecificChannels::rgb(|_: Vec2<usize>| (f16::ONE, f16::ONE, f16::ONE));
+        Image::from_channels((8, 8), ch).write().to_file(faces.join(format!("{name}.exr"))).unwrap();
+    }
+    let (code, said) = run_code(&["bake", faces.to_str().unwrap(), "--backend", "cpu", "--out", &dir("x")]);
+    assert!(code == 1 && said.contains("py.exr: is a folder"), "{said}");
+    std::fs::remove_dir(faces.join("py.exr")).unwrap();
+    std::os::unix::fs::symlink(d.join("nowhere.exr"), faces.join("py.exr")).unwrap();
+    let (code, said) = run_code(&["bake", faces.to_str().unwrap(), "--backend", "cpu", "--out", &dir("x")]);
+    assert!(code == 1 && said.contains("py.exr: is a symbolic link to nothing"), "{said}");
+    // Usage mistakes exit 2 whether clap or splitsum's validation catches them.
+    assert_eq!(run_code(&["bake", &env, "--samples", "0"]).0, 2);
+    assert_eq!(run_code(&["bake", &env, "--size", "0"]).0, 2);
+    assert_eq!(run_code(&["bake", "no-such.exr", "--out", &dir("x")]).0, 1);
+    // A successful GPU run without XDG_RUNTIME_DIR prints no error line.
+    let o = Command::new(env!("CARGO_BIN_EXE_runner"))
+        .args(["lut", "--size", "8", "--out", &dir("gpu.exr")])
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .output()
+        .unwrap();
+    assert!(o.status.success() && !String::from_utf8_lossy(&o.stderr).contains("error"), "{}", text(&o));
+    assert!(!d.join("x").exists(), "a refused run left its output");
+}
+
+/// One step of the promise's property test.
+#[derive(Clone, Debug)]
+enum Op {
+    /// `bake` into folder `folder` for target `target` (splitsum, khronos, filament).
+    Bake { folder: usize, target: usize, size: u32 },
+    /// `bake --scene` into `folder`.
+    Scene { folder: usize },
+    /// `report --quick` into `folder`.
+    Report { folder: usize },
+    /// The user writes a file into `folder` (which may be an output folder by then).
+    UserWrites { folder: usize, name: String, bytes: Vec<u8> },
+    /// `op`, interrupted by `signal` after `after_ms`.
+    Interrupted { op: Box<Op>, after_ms: u64, signal: i32 },
+}
+
+/// The arguments of a command op.
+fn op_args(op: &Op, env: &Path, scene: &Path, folders: &[PathBuf]) -> Vec<String> {
+    let s = |v: &[&str]| v.iter().map(|a| a.to_string()).collect::<Vec<_>>();
+    match op {
+        Op::Bake { folder, target, size } => {
+            let target = ["splitsum", "khronos", "filament"][*target];
+            let mut a = s(&["bake", env.to_str().unwrap(), "--backend", "cpu", "--size", &size.to_string(), "--target", target]);
+            if target != "filament" {
+                a.extend(s(&["--lut-size", "8", "--irradiance-size", "4"]));
+            }
+            a.extend(s(&["--out", folders[*folder].to_str().unwrap()]));
+            a
+        }
+        Op::Scene { folder } => s(&["bake", "--scene", scene.to_str().unwrap(), "--backend", "cpu", "--out", folders[*folder].to_str().unwrap()]),
+        Op::Report { folder } => s(&["report", env.to_str().unwrap(), "--quick", "--backends", "cpu", "--out", folders[*folder].to_str().unwrap()]),
+        Op::UserWrites { .. } | Op::Interrupted { .. } => unreachable!("not a command"),
+    }
+}
+
+/// Whether `dir` is a whole set written by splitsum, read independently of the library:
+/// its manifest lists every entry there, every listed entry is there, and every file has
+/// the listed size and BLAKE3 hash.
+fn whole_new_set(dir: &Path) -> Result<(), String> {
+    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join(".splitsum-manifest.json")).map_err(|e| format!("no manifest: {e}"))?)
+        .map_err(|e| format!("manifest: {e}"))?;
+    let mut listed = std::collections::BTreeSet::new();
+    for e in manifest["entries"].as_array().ok_or("no entries")? {
+        let rel = e["path"].as_str().ok_or("entry without a path")?;
+        listed.insert(dir.join(rel));
+        let p = dir.join(rel);
+        match e.get("file") {
+            Some(f) => {
+                let bytes = std::fs::read(&p).map_err(|err| format!("{rel}: {err}"))?;
+                if bytes.len() as u64 != f["bytes"].as_u64().unwrap() || blake3::hash(&bytes).to_hex().as_str() != f["blake3"].as_str().unwrap() {
+                    return Err(format!("{rel} differs from the manifest"));
+                }
+            }
+            None if p.is_dir() => {}
+            None => return Err(format!("{rel} is not a folder")),
+        }
+    }
+    for (p, _) in snapshot(dir) {
+        if p != dir.join(".splitsum-manifest.json") && !listed.contains(&p) {
+            return Err(format!("{} is not listed", p.display()));
+        }
+    }
+    Ok(())
+}
+
+fn ops() -> impl proptest::strategy::Strategy<Value = Vec<Op>> {
+    use proptest::prelude::*;
+    let command = prop_oneof![
+        9 => (0usize..2, 0usize..3, prop_oneof![Just(8u32), Just(16)]).prop_map(|(folder, target, size)| Op::Bake { folder, target, size }),
+        5 => (0usize..2).prop_map(|folder| Op::Scene { folder }),
+        1 => (0usize..2).prop_map(|folder| Op::Report { folder }),
+    ];
+    let op = prop_oneof![
+        10 => command.clone(),
+        3 => (0usize..2, "[a-z]{1,8}(\\.txt|\\.json|\\.exr)?", prop::collection::vec(any::<u8>(), 0..64))
+            .prop_map(|(folder, name, bytes)| Op::UserWrites { folder, name, bytes }),
+        5 => (command, 0u64..150, prop_oneof![Just(libc::SIGINT), Just(libc::SIGTERM)])
+            .prop_map(|(op, after_ms, signal)| Op::Interrupted { op: Box::new(op), after_ms, signal }),
+    ];
+    prop::collection::vec(op, 1..5)
+}
+
+/// The promise (issue 19), as a property: random sequences of `bake` (three targets),
+/// `bake --scene`, `report` and interruptions (SIGINT, SIGTERM) run into two folders that
+/// start missing, empty or holding the user's files, while the user adds files into them
+/// (outputs included). After every step every file of the user's is there byte for byte,
+/// every output folder is either the whole old set or a whole new set (read independently
+/// of the library), a folder holding the user's files is refused with exit code 2, and no
+/// staging folder is left. `PROPTEST_CASES` sets the number of sequences (200 by default;
+/// more by hand).
+#[test]
+fn the_users_files_survive_any_sequence_of_runs() {
+    use proptest::prelude::*;
+    use proptest::test_runner::{Config, TestRunner};
+    let d = scratch("promise");
+    let env = d.join("tiny.hdr");
+    {
+        use std::io::Write;
+        let mut f = std::fs::File::create(&env).unwrap();
+        write!(f, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32 +X 64\n").unwrap();
+        for i in 0..64 * 32u32 {
+            f.write_all(&[100 + (i % 64) as u8, 100, 100 + (i / 64) as u8, 128]).unwrap();
+        }
+    }
+    let scene = d.join("tiny.toml");
+    std::fs::write(
+        &scene,
+        "environment = \"tiny.hdr\"\n[quality]\nsize = 8\nlut_size = 8\n[[materials]]\nname = \"steel\"\nmetallic = 1.0\nroughness = [0.4, 0.7]\n[[objects]]\nkind = \"sphere-grid\"\nmaterial = \"steel\"\n",
+    )
+    .unwrap();
+    let cases = std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(200);
+    let mut runner_ = TestRunner::new(Config { cases, failure_persistence: None, ..Config::default() });
+    let case = std::sync::atomic::AtomicUsize::new(0);
+    let start = std::time::Instant::now();
+    let result = runner_.run(&(prop::collection::vec(0u8..3, 2), prop::collection::vec(("[a-z]{1,6}\\.(tex|png|json)", prop::collection::vec(any::<u8>(), 1..32)), 0..3), ops()), |(starts, seeds, ops)| {
+        let root = d.join(format!("case{}", case.fetch_add(1, std::sync::atomic::Ordering::Relaxed)));
+        let folders = [root.join("out"), root.join("deep/report")];
+        std::fs::create_dir_all(&root).unwrap();
+        // The user's files: beside the output folders always, inside them where a folder starts so.
+        let mut mine: std::collections::BTreeMap<PathBuf, Vec<u8>> = Default::default();
+        std::fs::write(root.join("thesis.tex"), b"mine").unwrap();
+        mine.insert(root.join("thesis.tex"), b"mine".to_vec());
+        for (k, start) in starts.iter().enumerate() {
+            match start {
+                0 => {}
+                1 => std::fs::create_dir_all(&folders[k]).unwrap(),
+                _ => {
+                    std::fs::create_dir_all(folders[k].join("figs")).unwrap();
+                    for (name, bytes) in seeds.iter().chain([&("plan.json".to_string(), b"{}".to_vec())]) {
+                        for p in [folders[k].join(name), folders[k].join("figs").join(name)] {
+                            std::fs::write(&p, bytes).unwrap();
+                            mine.insert(p, bytes.clone());
+                        }
+                    }
+                }
+            }
+        }
+        for op in &ops {
+            let before: Vec<_> = folders.iter().map(|f| snapshot_or_none(f)).collect();
+            let holds_mine: Vec<bool> = folders.iter().map(|f| mine.keys().any(|p| p.starts_with(f))).collect();
+            let (command, signal) = match op {
+                Op::UserWrites { folder, name, bytes } => {
+                    let p = folders[*folder].join(name);
+                    std::fs::create_dir_all(&folders[*folder]).unwrap();
+                    if !p.exists() {
+                        std::fs::write(&p, bytes).unwrap();
+                        mine.insert(p, bytes.clone());
+                    }
+                    continue;
+                }
+                Op::Interrupted { op, after_ms, signal } => (op.as_ref(), Some((*after_ms, *signal))),
+                op => (op, None),
+            };
+            let folder = match command {
+                Op::Bake { folder, .. } | Op::Scene { folder } | Op::Report { folder } => *folder,
+                _ => unreachable!(),
+            };
+            let args = op_args(command, &env, &scene, &folders);
+            let child = runner().args(&args).stdout(std::process::Stdio::null()).stderr(std::process::Stdio::piped()).spawn().unwrap();
+            if let Some((after, sig)) = signal {
+                std::thread::sleep(std::time::Duration::from_millis(after));
+                // SAFETY: signalling our own child (it may have exited already).
+                unsafe { libc::kill(child.id() as i32, sig) };
+            }
+            let o = child.wait_with_output().unwrap();
+            let said = String::from_utf8_lossy(&o.stderr).into_owned();
+            let code = o.status.code();
+            for (p, bytes) in &mine {
+                let now = std::fs::read(p).ok();
+                prop_assert_eq!(now.as_ref(), Some(bytes), "{:?} lost or changed by {:?}: {}", p, op, said);
+            }
+            for (k, f) in folders.iter().enumerate() {
+                let now = snapshot_or_none(f);
+                if now != before[k] {
+                    prop_assert!(k == folder && !holds_mine[k], "{:?} changed folder {} holding the user's files: {}", op, k, said);
+                    let whole = whole_new_set(f);
+                    prop_assert!(whole.is_ok(), "{:?} left folder {} neither old nor whole new: {:?}: {}", op, k, whole, said);
+                }
+            }
+            if holds_mine[folder] {
+                prop_assert!(code == Some(2) || (signal.is_some() && code.is_none()) || code == Some(130), "{:?} into a folder of the user's: {:?}: {}", op, code, said);
+            } else if signal.is_none() {
+                prop_assert_eq!(code, Some(0), "{:?}: {}", op, said);
+            }
+            for dir in [root.clone(), root.join("deep")] {
+                for e in std::fs::read_dir(&dir).into_iter().flatten() {
+                    let name = e.unwrap().file_name().to_string_lossy().into_owned();
+                    prop_assert!(!name.contains(".splitsum-") && !name.ends_with(".tmp"), "{:?} left {} in {}: {}", op, name, dir.display(), said);
+                }
+            }
+        }
+        let _ = std::fs::remove_dir_all(&root);
+        Ok(())
+    });
+    eprintln!("{cases} sequences in {:.1} s", start.elapsed().as_secs_f64());
+    if let Err(e) = result {
+        panic!("{e}");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// [`snapshot`] of `dir`, or `None` where it does not exist.
+fn snapshot_or_none(dir: &Path) -> Option<Vec<(PathBuf, Vec<u8>)>> {
+    dir.is_dir().then(|| snapshot(dir))
 }

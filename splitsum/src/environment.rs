@@ -285,9 +285,9 @@ fn read_hdr(path: &Path, weights: Weights, sanitize: bool, factor: u32) -> Resul
     let mut reducer = Reducer::new(w, h, factor, weights, sanitize);
     let mut line = vec![[0u8; 4]; w as usize];
     for y in 0..h {
-        rgbe::scanline(&mut r, &mut line).map_err(|e| {
-            let what = if e.kind() == std::io::ErrorKind::UnexpectedEof { "truncated Radiance HDR: the file ends" } else { "malformed Radiance HDR" };
-            Error::file(path, format!("{what} in scanline {y} of {h}: {e}"))
+        rgbe::scanline(&mut r, &mut line).map_err(|e| match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => Error::file(path, format!("truncated Radiance HDR: the file ends in scanline {y} of {h}")),
+            _ => Error::file(path, format!("malformed Radiance HDR in scanline {y} of {h}: {e}")),
         })?;
         for (x, p) in line.iter().enumerate() {
             reducer.push(x as u32, y, rgbe::to_f32(*p));

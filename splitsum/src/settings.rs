@@ -392,9 +392,14 @@ impl Settings {
     /// count capped at [`MAX_SAMPLES`], a source cube finer than the environment resolves.
     pub fn adjustments(&self, env: &crate::environment::Environment) -> Vec<Adjustment> {
         let mut out = Vec::new();
-        for (mip, (asked, used)) in self.asked_samples_per_mip().into_iter().zip(self.samples_per_mip()).enumerate() {
-            if mip > 0 && asked > used as u64 && self.mapping.roughness(mip as u32, self.mips) > 0.0 {
-                out.push(Adjustment::SamplesCapped { mip: mip as u32, asked, used });
+        let (roughness, samples) = (self.roughness(), self.samples_per_mip());
+        let source = CubeLayout::new(self.source_size, CubeLayout::full_chain(self.source_size));
+        let exact = exact_levels(&roughness, &samples, self.exact_sums, source);
+        for (mip, asked) in self.asked_samples_per_mip().into_iter().enumerate() {
+            // The mirror and a mip summed exactly take no samples.
+            let sampled = roughness[mip] > 0.0 && exact[mip] == prefilter::SAMPLED;
+            if sampled && asked > samples[mip] as u64 {
+                out.push(Adjustment::SamplesCapped { mip: mip as u32, asked, used: samples[mip] });
             }
         }
         if let crate::environment::Environment::Equirect(e) = env {
