@@ -254,7 +254,7 @@ fn buffered(path: &Path) -> Result<std::io::BufReader<std::fs::File>> {
 }
 
 /// Reads an `.hdr` or `.exr` equirect as RGBA f32 (alpha 1), row 0 at the top, reduced by
-/// `factor` ([`Reducer`]) and cleaned ([`clean`]'s rules).
+/// `factor` (area-weighted, as it is decoded) and cleaned ([`clean`]'s rules).
 pub fn read_reduced(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
     read_with(path, Weights::EquirectRows, sanitize, factor)
 }
