@@ -354,10 +354,13 @@ pub struct Scene {
     pub dir: PathBuf,
 }
 
+/// The largest scene file read (a scene is a few hundred bytes of TOML).
+pub const MAX_SCENE_BYTES: u64 = 1 << 20;
+
 impl Scene {
     /// Reads and checks a scene file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+        let text = splitsum::files::read_text(path, MAX_SCENE_BYTES)?;
         let mut scene = Self::parse(&text).map_err(|e| match e {
             Error::Invalid(m) => Error::Invalid(format!("{}: {m}", path.display())),
             other => other,

@@ -734,6 +734,11 @@ fn each_case_names_the_real_problem_with_one_exit_code_rule() {
     std::os::unix::fs::symlink(d.join("nowhere.exr"), faces.join("py.exr")).unwrap();
     let (code, said) = run_code(&["bake", faces.to_str().unwrap(), "--backend", "cpu", "--out", &dir("x")]);
     assert!(code == 1 && said.contains("py.exr: is a symbolic link to nothing"), "{said}");
+    // A scene or calibration that is a device is refused before it is read (it would never end).
+    let (code, said) = run_code(&["plan", "/dev/zero"]);
+    assert!(code == 1 && said.contains("/dev/zero: is not a regular file"), "{said}");
+    let (code, said) = run_code(&["plan", &scene, "--calibration", "/dev/zero"]);
+    assert!(code == 1 && said.contains("/dev/zero: is not a regular file"), "{said}");
     // Usage mistakes exit 2 whether clap or splitsum's validation catches them.
     assert_eq!(run_code(&["bake", &env, "--samples", "0"]).0, 2);
     assert_eq!(run_code(&["bake", &env, "--size", "0"]).0, 2);

@@ -180,11 +180,7 @@ impl Cache {
 
     fn read(&self, key: &str, dir: &Path) -> std::result::Result<BakedEnvironment, String> {
         let manifest = dir.join("manifest.json");
-        match std::fs::metadata(&manifest) {
-            Ok(m) if m.len() > MAX_MANIFEST_BYTES => return Err(format!("a manifest of {} bytes is not one of ours", m.len())),
-            _ => {}
-        }
-        let text = std::fs::read_to_string(&manifest).map_err(|e| format!("no readable manifest ({e})"))?;
+        let text = crate::files::read_text(&manifest, MAX_MANIFEST_BYTES).map_err(|e| format!("no readable manifest ({e})"))?;
         let m: Manifest = serde_json::from_str(&text).map_err(|e| format!("malformed manifest ({e})"))?;
         if m.format != FORMAT || m.key != key {
             return Err(format!("a foreign entry (its manifest names key {} in format {})", m.key, m.format));
@@ -192,7 +188,11 @@ impl Cache {
         let file = |name: &str| -> std::result::Result<Vec<u8>, String> {
             let want = m.files.get(name).ok_or_else(|| format!("the manifest lists no {name}"))?;
             // The size first: a file longer than the manifest says is never read in.
-            let len = std::fs::metadata(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?.len();
+            let meta = std::fs::metadata(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?;
+            if !meta.is_file() {
+                return Err(format!("{name} is not a regular file"));
+            }
+            let len = meta.len();
             if len != want.bytes {
                 return Err(format!("{name} is corrupt (it holds {len} bytes, the manifest says {})", want.bytes));
             }

@@ -34,6 +34,24 @@ pub fn check_writable(path: &Path) -> Result<()> {
     Ok(())
 }
 
+/// Reads the regular file `path` as text of at most `max` bytes (a scene, a calibration):
+/// a device, a pipe or a larger file is refused before it is read, so no input file can
+/// make a reader hold more than `max`.
+pub fn read_text(path: &Path, max: u64) -> Result<String> {
+    use std::io::Read;
+    let file = File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let meta = file.metadata().map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    if !meta.is_file() {
+        return Err(Error::file(path, "is not a regular file"));
+    }
+    if meta.len() > max {
+        return Err(Error::file(path, format!("is {} bytes; a file of this kind has at most {max}", meta.len())));
+    }
+    let mut text = String::new();
+    file.take(max).read_to_string(&mut text).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    Ok(text)
+}
+
 /// The kind of a single-file output: what splitsum writes under a name, and the only kind
 /// of existing file it replaces.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

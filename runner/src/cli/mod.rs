@@ -76,7 +76,8 @@ impl SceneArgs {
         match &self.calibration {
             None => Ok(crate::cost::Calibration::default()),
             Some(p) => {
-                let text = std::fs::read_to_string(p).map_err(|e| crate::Error::file(p, format!("cannot read: {e}")))?;
+                // A report.csv of the full sweep is about 40 KiB.
+                let text = crate::files::read_text(p, 64 << 20)?;
                 crate::cost::Calibration::from_report_csv(&text)
                     .ok_or_else(|| crate::Error::file(p, "is not a report.csv of `runner report` (no brdf lut, prefilter and irradiance rows)").into())
             }
