@@ -91,7 +91,7 @@ fn lut_writes_exr_and_png() {
 
 #[test]
 fn missing_gpu_names_the_cpu_backend_and_lavapipe() {
-    let e = splitsum::backend::Gpu::matching(Some("no-such-adapter-anywhere")).err().expect("no adapter").to_string();
+    let e = splitsum::backend::Gpu::matching(wgpu::Backends::all(), Some("no-such-adapter-anywhere")).err().expect("no adapter").to_string();
     assert!(e.contains("on the CPU") && e.contains("mesa-vulkan-drivers") && !e.contains("--"), "the library's own terms: {e}");
 }
 
@@ -120,7 +120,7 @@ fn names(dir: &std::path::Path) -> Vec<String> {
 fn an_output_folder_is_replaced_whole() {
     let d = scratch("unit");
     let out = d.join("out");
-    let (o, env) = (out.to_str().unwrap(), repo("assets/environments/courtyard.exr"));
+    let (o, env) = (out.to_str().unwrap(), repo("splitsum/assets/courtyard.exr"));
     ok(&["bake", &env, "--backend", "cpu", "--size", "32", "--out", o]);
     assert!(out.join("specular_mip1.exr").exists() && out.join("sh9.json").exists());
     ok(&["bake", &env, "--backend", "cpu", "--size", "32", "--mips", "1", "--out", o]);
@@ -143,12 +143,12 @@ fn output_folder_mistakes_are_refused_in_the_users_terms() {
     assert!(!d.join("new").exists(), "a failed bake left {:?}", names(&d));
     let file = d.join("file.txt");
     std::fs::write(&file, "mine").unwrap();
-    let e = err(&["bake", &repo("assets/environments/courtyard.exr"), "--out", file.to_str().unwrap()]);
+    let e = err(&["bake", &repo("splitsum/assets/courtyard.exr"), "--out", file.to_str().unwrap()]);
     assert!(e.contains("--out") && e.contains("existing file"), "{e}");
     let theirs = d.join("theirs");
     std::fs::create_dir_all(&theirs).unwrap();
     std::fs::write(theirs.join("notes.txt"), "mine").unwrap();
-    let e = err(&["bake", &repo("assets/environments/courtyard.exr"), "--out", theirs.to_str().unwrap()]);
+    let e = err(&["bake", &repo("splitsum/assets/courtyard.exr"), "--out", theirs.to_str().unwrap()]);
     assert!(e.contains("--out") && e.contains("notes.txt"), "{e}");
     assert_eq!(std::fs::read_to_string(theirs.join("notes.txt")).unwrap(), "mine");
 }
@@ -160,7 +160,7 @@ fn output_folder_mistakes_are_refused_in_the_users_terms() {
 #[test]
 fn messages_name_the_users_own_input() {
     let d = scratch("msgs");
-    let env = repo("assets/environments/courtyard.exr");
+    let env = repo("splitsum/assets/courtyard.exr");
     ok(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", d.join("small").to_str().unwrap()]);
     let e = err(&["bake", &env, "--samples", "-1"]);
     assert!(e.contains("--samples") && e.contains("-1") && !e.contains("-- -1"), "{e}");
@@ -198,7 +198,7 @@ fn outputs_follow_their_names() {
 /// flags that set it, unless `--force`.
 #[test]
 fn runs_estimated_over_an_hour_are_refused() {
-    let env = repo("assets/environments/courtyard.exr");
+    let env = repo("splitsum/assets/courtyard.exr");
     let e = err(&["bake", &env, "--backend", "cpu", "--size", "2048", "--samples", "1048576", "--sampled-only"]);
     assert!(e.contains("estimated to take") && e.contains("--samples") && e.contains("--force"), "{e}");
     let e = err(&["lut", "--backend", "cpu", "--size", "4096", "--method", "sampled", "--samples", "100000000"]);

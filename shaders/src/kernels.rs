@@ -468,3 +468,36 @@ pub fn unpack_rows(
         texels[(p.texel_offset + id.y * p.width + id.x) as usize] = half::clean_radiance(v);
     }
 }
+
+/// Parameters of [`read_cube`].
+#[derive(Copy, Clone, Debug, Pod, Zeroable)]
+#[repr(C)]
+pub struct ReadCubeParams {
+    /// Face size of the level read.
+    pub size: u32,
+    /// The mip level read.
+    pub level: u32,
+    /// Index of the output's first texel.
+    pub texel_offset: u32,
+}
+
+/// Texel `(id.x, id.y)` of face `id.z` of mip `level` of a cube texture, cleaned
+/// (`half::clean_radiance`), into dense `Vec4` texels (faces in order, rows top to bottom).
+/// The cube is sampled at the texel's centre direction (`cubemap::texel_dir`) with a
+/// nearest-texel sampler at that exact level, which returns the texel itself: for devices
+/// that cannot copy a cube texture to a buffer (wgpu's GL backend reports "Not implemented
+/// yet: cubemap texture copy to buffer" and copies nothing).
+#[spirv(compute(threads(8, 8)))]
+pub fn read_cube(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &ReadCubeParams,
+    #[spirv(descriptor_set = 0, binding = 1)] cube: &spirv_std::Image!(cube, type = f32, sampled),
+    #[spirv(descriptor_set = 0, binding = 3)] sampler: &spirv_std::Sampler,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] texels: &mut [Vec4],
+) {
+    if id.x < p.size && id.y < p.size && id.z < cubemap::FACES {
+        let d = cubemap::texel_dir(id.z, id.x, id.y, p.size);
+        let v: Vec4 = cube.sample_by_lod(*sampler, d, p.level as f32);
+        texels[(p.texel_offset + (id.z * p.size + id.y) * p.size + id.x) as usize] = half::clean_radiance(v);
+    }
+}

@@ -184,6 +184,19 @@ pub const KERNELS_PROBE: EntryPoint = EntryPoint {
     ],
 };
 
+/// `kernels::read_cube`.
+pub const KERNELS_READ_CUBE: EntryPoint = EntryPoint {
+    name: "kernels::read_cube",
+    stage: Stage::Compute,
+    workgroup_size: [8, 8, 1],
+    bindings: &[
+        Binding { group: 0, binding: 0, resource: Resource::Uniform },
+        Binding { group: 0, binding: 1, resource: Resource::Texture { dimension: Dimension::Cube } },
+        Binding { group: 0, binding: 2, resource: Resource::Storage { read_only: false } },
+        Binding { group: 0, binding: 3, resource: Resource::Sampler },
+    ],
+};
+
 /// `kernels::resolve_lut`.
 pub const KERNELS_RESOLVE_LUT: EntryPoint = EntryPoint {
     name: "kernels::resolve_lut",
@@ -221,4 +234,4 @@ pub const KERNELS_UNPACK_ROWS: EntryPoint = EntryPoint {
 };
 
 /// Every compute entry point.
-pub const KERNELS: [EntryPoint; 14] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9, KERNELS_PACK_HALF, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];
+pub const KERNELS: [EntryPoint; 15] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9, KERNELS_PACK_HALF, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];

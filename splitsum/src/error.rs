@@ -7,11 +7,12 @@ use thiserror::Error;
 /// Something splitsum could not do.
 #[derive(Debug, Error)]
 pub enum Error {
-    /// No Vulkan adapter: the GPU backend cannot run here.
+    /// No GPU adapter: the GPU backend cannot run here.
     #[error(
-        "no Vulkan GPU adapter found{detail}.\n  \
-         Bake on the CPU instead, or install a Vulkan driver; on Debian or Ubuntu the CPU \
-         driver lavapipe works: `sudo apt-get install -y mesa-vulkan-drivers libvulkan1`"
+        "no GPU adapter found{detail}.\n  \
+         Bake on the CPU instead, or install a driver; on Debian or Ubuntu Mesa's CPU \
+         drivers work: `sudo apt-get install -y mesa-vulkan-drivers libvulkan1` (Vulkan, \
+         lavapipe) or `libegl1 libgles2 libgl1-mesa-dri` (GL, llvmpipe)"
     )]
     NoAdapter {
         /// What wgpu said, if anything.

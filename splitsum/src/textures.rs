@@ -13,7 +13,7 @@
 //! ([`Source::Texture`]: an equirect `2h × h`, or a cube of six square layers; RGBA16F or
 //! RGBA32F with `COPY_SRC`). Nothing is read back unless asked ([`Ibl::read`]).
 
-use crate::backend::{Cpu, Gpu, Kernels, gpu::Texels};
+use crate::backend::{Cpu, Gpu, Kernels, gpu, gpu::Texels};
 use crate::bake::{self, Baked, Made, Timing};
 use crate::environment::Environment;
 use crate::error::{Error, Result};
@@ -298,6 +298,12 @@ impl Baker {
     /// A caller's texture read into host memory (the CPU backend's source).
     fn read_source(&self, texture: &wgpu::Texture) -> Result<Environment> {
         let shape = texture_shape(texture)?;
+        if matches!(shape, Shape::Cube) && !gpu::copies_cubes(&self.device) {
+            let size = texture.size().width;
+            let layout = CubeLayout::new(size, 1);
+            let texels = read_cube(&self.device, &self.queue, texture, layout)?;
+            return Ok(Environment::Cube(Cube { layout, texels: texels.into_iter().map(|v| v.truncate().extend(1.0)).collect() }));
+        }
         let (buffer, row, half) = self.copy_out(texture, wgpu::BufferUsages::MAP_READ)?;
         let bytes = crate::backend::gpu::map_read(&self.device, &buffer)?;
         let words: &[u32] = bytemuck::cast_slice(&bytes);
@@ -337,9 +343,42 @@ fn texture_shape(t: &wgpu::Texture) -> Result<Shape> {
     }
 }
 
+/// Every level `layout` names of the cube `texture`, read on the device with the
+/// `read_cube` kernel (where the device cannot copy cubes, `gpu::copies_cubes`), into host
+/// memory.
+fn read_cube(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layout: CubeLayout) -> Result<Vec<Vec4>> {
+    let bytes = layout.texel_count() as u64 * 16;
+    let out = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("splitsum cube texels"),
+        size: bytes,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("splitsum readback"),
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum read cube") });
+    gpu::CubeReader::new(device, texture.format()).record(device, &mut encoder, texture, layout, &out);
+    encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
+    queue.submit([encoder.finish()]);
+    Ok(bytemuck::cast_slice(&gpu::map_read(device, &staging)?).to_vec())
+}
+
 /// The source cube of `settings` from a texture on the device, without leaving it.
 fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) -> Result<(Texels, CubeLayout)> {
     let shape = texture_shape(texture)?;
+    if matches!(shape, Shape::Cube) && !gpu::copies_cubes(&g.device) {
+        let size = texture.size().width;
+        let count = CubeLayout::new(size, CubeLayout::full_chain(size)).texel_count();
+        let texels = Texels { buffer: g.output("source texels", count as u64 * 16)?, count };
+        let mut encoder = g.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum source cube") });
+        gpu::CubeReader::new(&g.device, texture.format()).record(&g.device, &mut encoder, texture, CubeLayout::new(size, 1), &texels.buffer);
+        g.queue.submit([encoder.finish()]);
+        return cube_from_texture(g, texels, size, settings);
+    }
     let baker = Baker { device: g.device.clone(), queue: g.queue.clone(), gpu: None };
     let (words, row, half) = baker.copy_out(texture, wgpu::BufferUsages::STORAGE)?;
     let size = texture.size();
@@ -366,15 +405,20 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) ->
                 CubeLayout::new(source_size, CubeLayout::full_chain(source_size)),
             ))
         }
-        Shape::Cube if settings.target.fixed().mirror_faces => Err(Error::setting(
-            "target",
-            format!(
-                "{}: a cube texture is not mirrored on the device; pass its faces as host data (Source::Environment) or an equirect",
-                settings.target.name()
-            ),
-        )),
-        Shape::Cube => bake::cube_source(g, texels, size.width, settings),
+        Shape::Cube => cube_from_texture(g, texels, size.width, settings),
     }
+}
+
+/// The source cube of `settings` from a cube texture's level 0, read into `texels` (its
+/// full mip chain long), faces `face` wide.
+fn cube_from_texture(g: &Gpu, texels: Texels, face: u32, settings: &Settings) -> Result<(Texels, CubeLayout)> {
+    if settings.target.fixed().mirror_faces {
+        return Err(Error::setting(
+            "target",
+            format!("{}: a cube texture is not mirrored on the device; pass its faces as host data (Source::Environment) or an equirect", settings.target.name()),
+        ));
+    }
+    bake::cube_source(g, texels, face, settings)
 }
 
 impl Ibl {
@@ -420,7 +464,11 @@ impl Ibl {
             }
             Ok(out)
         };
-        let cube = |t: &wgpu::Texture| -> Result<Cube> { Ok(Cube { layout: CubeLayout::new(t.size().width, t.mip_level_count()), texels: read(t, 4)? }) };
+        let cube = |t: &wgpu::Texture| -> Result<Cube> {
+            let layout = CubeLayout::new(t.size().width, t.mip_level_count());
+            let texels = if gpu::copies_cubes(device) { read(t, 4)? } else { read_cube(device, queue, t, layout)? };
+            Ok(Cube { layout, texels })
+        };
         Ok(IblData { specular: cube(&self.specular)?, irradiance: cube(&self.irradiance)?, brdf: read(&self.brdf, 2)? })
     }
 }

@@ -52,7 +52,13 @@ fn run(check: bool) -> Result<bool, Error> {
     let result = builder.build()?;
     let spv = std::fs::read(result.module.unwrap_single())?;
     let words: Vec<u32> = spv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-    let module = rspirv::dr::load_words(&words).map_err(|e| format!("reading the module back: {e}"))?;
+    let mut module = rspirv::dr::load_words(&words).map_err(|e| format!("reading the module back: {e}"))?;
+    let rewritten = latch_conditions_local(&mut module);
+    eprintln!("xtask: {rewritten} loop latches given a condition of their own (see latch_conditions_local)");
+    let spv: Vec<u8> = {
+        use rspirv::binary::Assemble;
+        module.assemble().iter().flat_map(|w| w.to_le_bytes()).collect()
+    };
     let linkage = linkage(&module)?;
 
     let outputs = [(root.join("spirv/src/splitsum_shaders.spv"), spv), (root.join("spirv/src/linkage.rs"), linkage.into_bytes())];
@@ -72,6 +78,82 @@ fn run(check: bool) -> Result<bool, Error> {
         }
     }
     Ok(same)
+}
+
+/// Gives every loop whose latch (continue block) branches on a condition computed
+/// elsewhere in the loop a copy of that condition of its own: `%c2 = OpPhi %bool %c %pred…`
+/// at the top of the continue block, branched on instead of `%c`.
+///
+/// rust-gpu's structurizer ends every loop in a continue block `OpBranchConditional %c
+/// %header %merge`, where `%c` is the loop condition computed in the header. naga (wgpu
+/// 30) translates such a loop for GLSL, HLSL and MSL as `while (true) { if (!init) {
+/// continuing; if (!c) break; } body }` and, `%c` being out of scope there, re-evaluates it
+/// from the header's phi variables *after* the continuing block has already stored the next
+/// iteration's values into them: every loop then stops one iteration early and drops its
+/// last term (on GL, the BRDF table came out 15–44 % low, the specular cube 34 %). SPIR-V
+/// for Vulkan is regenerated from SSA and is not affected. A phi in the continue block
+/// becomes a local variable of its own in naga, stored where the body ends and read in
+/// the continuing block, so the condition of this iteration is what decides. Returns how
+/// many loops were rewritten; `tests/portability.rs` checks naga's IR of the module for
+/// the pattern.
+fn latch_conditions_local(module: &mut Module) -> usize {
+    use rspirv::dr::Instruction;
+    let mut next_id = module.header.as_ref().map_or(1, |h| h.bound);
+    let bool_type = module.types_global_values.iter().find(|i| i.class.opcode == Op::TypeBool).and_then(|i| i.result_id);
+    let Some(bool_type) = bool_type else { return 0 };
+    let mut rewritten = 0;
+    for f in &mut module.functions {
+        let label = |b: &rspirv::dr::Block| b.label.as_ref().and_then(|l| l.result_id);
+        // Each loop header's (merge, continue).
+        let loops: Vec<(u32, u32, u32)> = f
+            .blocks
+            .iter()
+            .filter_map(|b| {
+                let m = b.instructions.iter().find(|i| i.class.opcode == Op::LoopMerge)?;
+                match (m.operands.first(), m.operands.get(1)) {
+                    (Some(Operand::IdRef(merge)), Some(Operand::IdRef(cont))) => Some((label(b)?, *merge, *cont)),
+                    _ => None,
+                }
+            })
+            .collect();
+        for (header, merge, cont) in loops {
+            let Some(ci) = f.blocks.iter().position(|b| label(b) == Some(cont)) else { continue };
+            let defined_here: BTreeSet<u32> = f.blocks[ci].instructions.iter().filter_map(|i| i.result_id).collect();
+            let Some(term) = f.blocks[ci].instructions.last() else { continue };
+            let (cond, a, b) = match (term.class.opcode, term.operands.as_slice()) {
+                (Op::BranchConditional, [Operand::IdRef(c), Operand::IdRef(a), Operand::IdRef(b), ..]) => (*c, *a, *b),
+                _ => continue,
+            };
+            let latch = (a == header && b == merge) || (a == merge && b == header);
+            if !latch || defined_here.contains(&cond) {
+                continue;
+            }
+            // The continue block's predecessors: blocks whose terminator names it.
+            let preds: Vec<u32> = f
+                .blocks
+                .iter()
+                .filter(|blk| blk.instructions.last().is_some_and(|t| t.operands.iter().any(|o| *o == Operand::IdRef(cont))))
+                .filter_map(label)
+                .collect();
+            if preds.is_empty() {
+                continue;
+            }
+            let id = next_id;
+            next_id += 1;
+            let operands = preds.iter().flat_map(|p| [Operand::IdRef(cond), Operand::IdRef(*p)]).collect();
+            let phi = Instruction::new(Op::Phi, Some(bool_type), Some(id), operands);
+            let block = &mut f.blocks[ci];
+            let at = block.instructions.iter().take_while(|i| i.class.opcode == Op::Phi).count();
+            block.instructions.insert(at, phi);
+            let term = block.instructions.last_mut().expect("a terminator");
+            term.operands[0] = Operand::IdRef(id);
+            rewritten += 1;
+        }
+    }
+    if let Some(h) = module.header.as_mut() {
+        h.bound = next_id;
+    }
+    rewritten
 }
 
 /// What a binding holds, as `splitsum_spirv::Resource` spells it.

@@ -102,23 +102,54 @@ pub fn group_layout(entries: &[&EntryPoint], group: u32) -> Vec<wgpu::BindGroupL
     out
 }
 
-/// A Vulkan-only wgpu instance.
-pub fn vulkan_instance() -> wgpu::Instance {
-    wgpu::Instance::new(wgpu::InstanceDescriptor { backends: wgpu::Backends::VULKAN, ..wgpu::InstanceDescriptor::new_without_display_handle() })
+/// The graphics APIs splitsum looks for adapters on: `WGPU_BACKEND` (wgpu's own variable,
+/// a comma-separated list such as `vulkan`, `gl`, `metal`, `dx12`) if set, else every API
+/// this build of wgpu has.
+pub fn backends_from_env() -> wgpu::Backends {
+    wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all())
 }
 
-/// The adapters `instance` can see through Vulkan, best first: discrete, integrated,
-/// virtual, then CPU (lavapipe); only those whose name contains `filter`, if given.
-pub fn vulkan_adapters(instance: &wgpu::Instance, filter: Option<&str>) -> Vec<wgpu::Adapter> {
-    let mut adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN));
-    let rank = |t: wgpu::DeviceType| match t {
-        wgpu::DeviceType::DiscreteGpu => 0,
-        wgpu::DeviceType::IntegratedGpu => 1,
-        wgpu::DeviceType::VirtualGpu => 2,
-        wgpu::DeviceType::Other => 3,
-        wgpu::DeviceType::Cpu => 4,
+/// A wgpu instance on `backends`.
+pub fn instance(backends: wgpu::Backends) -> wgpu::Instance {
+    wgpu::Instance::new(wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle() })
+}
+
+/// The graphics API of an adapter, as people name it.
+pub fn api_name(backend: wgpu::Backend) -> &'static str {
+    match backend {
+        wgpu::Backend::Vulkan => "Vulkan",
+        wgpu::Backend::Metal => "Metal",
+        wgpu::Backend::Dx12 => "DX12",
+        wgpu::Backend::Gl => "GL",
+        wgpu::Backend::BrowserWebGpu => "WebGPU",
+        wgpu::Backend::Noop => "no-op",
+    }
+}
+
+/// The adapters `instance` sees on `backends`, best first: discrete, integrated, virtual,
+/// other, then CPU (lavapipe, llvmpipe, WARP); among equals Vulkan, Metal, DX12, then GL.
+/// Only those whose name contains `filter` (case-insensitive), if given.
+pub fn adapters(instance: &wgpu::Instance, backends: wgpu::Backends, filter: Option<&str>) -> Vec<wgpu::Adapter> {
+    let mut adapters = pollster::block_on(instance.enumerate_adapters(backends));
+    let rank = |info: wgpu::AdapterInfo| {
+        let device = match info.device_type {
+            wgpu::DeviceType::DiscreteGpu => 0,
+            wgpu::DeviceType::IntegratedGpu => 1,
+            wgpu::DeviceType::VirtualGpu => 2,
+            wgpu::DeviceType::Other => 3,
+            wgpu::DeviceType::Cpu => 4,
+        };
+        let api = match info.backend {
+            wgpu::Backend::Vulkan => 0,
+            wgpu::Backend::Metal => 1,
+            wgpu::Backend::Dx12 => 2,
+            wgpu::Backend::BrowserWebGpu => 3,
+            wgpu::Backend::Gl => 4,
+            wgpu::Backend::Noop => 5,
+        };
+        (device, api)
     };
-    adapters.sort_by_key(|a| rank(a.get_info().device_type));
+    adapters.sort_by_key(|a| rank(a.get_info()));
     if let Some(want) = filter {
         let want = want.to_lowercase();
         adapters.retain(|a| a.get_info().name.to_lowercase().contains(&want));
@@ -127,19 +158,22 @@ pub fn vulkan_adapters(instance: &wgpu::Instance, filter: Option<&str>) -> Vec<w
 }
 
 impl Gpu {
-    /// Opens the best Vulkan adapter and builds every pipeline. The environment variable
-    /// `SPLITSUM_ADAPTER` restricts the choice to adapters whose name contains its value.
+    /// Opens the best adapter (see [`adapters`]) on the APIs `WGPU_BACKEND` names (all, if
+    /// unset) whose name contains `WGPU_ADAPTER_NAME` (any, if unset), wgpu's own
+    /// variables, and builds every pipeline.
     pub fn new() -> Result<Self> {
-        Self::matching(std::env::var("SPLITSUM_ADAPTER").ok().as_deref())
+        Self::matching(backends_from_env(), std::env::var("WGPU_ADAPTER_NAME").ok().as_deref())
     }
 
-    /// Opens the best Vulkan adapter whose name contains `filter` (any, if `None`).
-    pub fn matching(filter: Option<&str>) -> Result<Self> {
-        let instance = vulkan_instance();
-        let adapter = vulkan_adapters(&instance, filter).into_iter().next().ok_or_else(|| Error::NoAdapter {
-            detail: match filter {
-                Some(want) => format!(" whose name contains {want:?} (SPLITSUM_ADAPTER)"),
-                None => String::new(),
+    /// Opens the best adapter on `backends` whose name contains `filter` (any, if `None`).
+    pub fn matching(backends: wgpu::Backends, filter: Option<&str>) -> Result<Self> {
+        let instance = instance(backends);
+        let adapter = adapters(&instance, backends, filter).into_iter().next().ok_or_else(|| Error::NoAdapter {
+            detail: match (filter, backends == wgpu::Backends::all()) {
+                (Some(want), true) => format!(" whose name contains {want:?} (WGPU_ADAPTER_NAME)"),
+                (Some(want), false) => format!(" on {backends:?} (WGPU_BACKEND) whose name contains {want:?} (WGPU_ADAPTER_NAME)"),
+                (None, true) => String::new(),
+                (None, false) => format!(" on {backends:?} (WGPU_BACKEND)"),
             },
         })?;
         Self::with_adapter(instance, adapter)
@@ -172,22 +206,11 @@ impl Gpu {
         });
         let pipelines = splitsum_spirv::KERNELS
             .iter()
+            // The cube reader binds a texture of the caller's format: built when needed.
+            .filter(|k| k.name != spirv::KERNELS_READ_CUBE.name)
             .map(|k| {
                 let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
-                let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                    label: Some(k.name),
-                    bind_group_layouts: &[Some(&layout)],
-                    immediate_size: 0,
-                });
-                let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                    label: Some(k.name),
-                    layout: Some(&pipeline_layout),
-                    module: &module,
-                    entry_point: Some(k.name),
-                    compilation_options: Default::default(),
-                    cache: None,
-                });
-                (k.name, (p, layout))
+                (k.name, (kernel_pipeline(device, &module, k, &layout), layout))
             })
             .collect();
         if let Some(e) = pollster::block_on(scope.pop()) {
@@ -202,9 +225,10 @@ impl Gpu {
         Ok(Self { instance: None, adapter: None, module, device: device.clone(), queue: queue.clone(), info, pipelines, empty })
     }
 
-    /// A one-line description of the adapter.
+    /// A one-line description of the adapter and its API.
     pub fn describe(&self) -> String {
-        format!("{} ({:?}, {} {})", self.info.name, self.info.device_type, self.info.driver, self.info.driver_info)
+        let driver = [self.info.driver.as_str(), self.info.driver_info.as_str()].iter().filter(|s| !s.is_empty()).copied().collect::<Vec<_>>().join(" ");
+        format!("{} on {} ({:?}, {driver})", self.info.name, api_name(self.info.backend), self.info.device_type)
     }
 
     /// Whether the adapter is a software rasteriser on the CPU (lavapipe, SwiftShader).
@@ -310,6 +334,104 @@ impl Gpu {
         self.queue.submit([encoder.finish()]);
         map_read(&self.device, &staging)
     }
+}
+
+/// Whether `device` copies cube textures to buffers. wgpu's GL backend makes every square
+/// six-layer texture a GL cube map and copies none of them ("Not implemented yet: cubemap
+/// texture copy to buffer", and the buffer stays zero); there [`CubeReader`] reads them.
+pub fn copies_cubes(device: &wgpu::Device) -> bool {
+    device.adapter_info().backend != wgpu::Backend::Gl
+}
+
+/// Reads cube textures into storage buffers with the `read_cube` kernel, where the device
+/// cannot copy them ([`copies_cubes`]): every texel sampled at its centre direction with a
+/// nearest-texel sampler at its exact level, which returns the texel unchanged.
+pub struct CubeReader {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+impl CubeReader {
+    /// The kernel's pipeline on `device` for textures of `format` (filterable or not, as
+    /// `Rgba32Float` is not).
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
+        let k = &spirv::KERNELS_READ_CUBE;
+        let filterable = format.guaranteed_format_features(device.features()).flags.contains(wgpu::TextureFormatFeatureFlags::FILTERABLE);
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = group_layout(&[k], 0)
+            .into_iter()
+            .map(|mut e| {
+                e.ty = match e.ty {
+                    wgpu::BindingType::Texture { view_dimension, multisampled, .. } => {
+                        wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable }, view_dimension, multisampled }
+                    }
+                    wgpu::BindingType::Sampler(_) if !filterable => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::NonFiltering),
+                    t => t,
+                };
+                e
+            })
+            .collect();
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &entries });
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("splitsum-shaders"),
+            source: wgpu::ShaderSource::SpirV(Cow::Borrowed(splitsum_spirv::words())),
+        });
+        let pipeline = kernel_pipeline(device, &module, k, &layout);
+        // Nearest in every direction: the texel at the sampled point, at the exact level.
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor { label: Some("splitsum cube reader"), ..Default::default() });
+        Self { pipeline, layout, sampler }
+    }
+
+    /// Records the reading of every mip of the cube `texture` into `out`, texels laid out
+    /// as `layout` (level by level, face by face), cleaned (`half::clean_radiance`).
+    pub fn record(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, layout: CubeLayout, out: &wgpu::Buffer) {
+        use splitsum_shaders::kernels::ReadCubeParams;
+        let k = &spirv::KERNELS_READ_CUBE;
+        let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::Cube), ..Default::default() });
+        let groups: Vec<(wgpu::BindGroup, [u32; 3])> = (0..layout.levels)
+            .map(|level| {
+                let size = layout.level_size(level);
+                let p = ReadCubeParams { size, level, texel_offset: layout.level_offset(level) };
+                let mut bytes = bytemuck::bytes_of(&p).to_vec();
+                bytes.resize(bytes.len().next_multiple_of(16), 0);
+                let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("params"), contents: &bytes, usage: wgpu::BufferUsages::UNIFORM });
+                let entries: Vec<wgpu::BindGroupEntry> = k
+                    .bindings
+                    .iter()
+                    .map(|b| wgpu::BindGroupEntry {
+                        binding: b.binding,
+                        resource: match b.resource {
+                            Resource::Uniform => params.as_entire_binding(),
+                            Resource::Storage { .. } => out.as_entire_binding(),
+                            Resource::Texture { .. } => wgpu::BindingResource::TextureView(&view),
+                            Resource::Sampler => wgpu::BindingResource::Sampler(&self.sampler),
+                        },
+                    })
+                    .collect();
+                let group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &self.layout, entries: &entries });
+                (group, k.workgroups([size, size, FACES]))
+            })
+            .collect();
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("read cube"), timestamp_writes: None });
+        pass.set_pipeline(&self.pipeline);
+        for (group, [x, y, z]) in &groups {
+            pass.set_bind_group(0, group, &[]);
+            pass.dispatch_workgroups(*x, *y, *z);
+        }
+    }
+}
+
+/// The compute pipeline of kernel `k` of `module`, with the bind group layout `layout`.
+fn kernel_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, k: &EntryPoint, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(k.name), bind_group_layouts: &[Some(layout)], immediate_size: 0 });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(k.name),
+        layout: Some(&pipeline_layout),
+        module,
+        entry_point: Some(k.name),
+        compilation_options: Default::default(),
+        cache: None,
+    })
 }
 
 /// Waits for `device` and maps `buffer` (created with `MAP_READ`) to read it.
