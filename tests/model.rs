@@ -7,10 +7,10 @@ use splitsum_shaders::glam::{Vec3, Vec4};
 use std::path::PathBuf;
 
 fn sample_path() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/models/torus.glb")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../display/assets/torus.glb")
 }
 
-/// `assets/models/torus.glb` is what `support::model::sample_glb` writes (regenerate with
+/// `display/assets/torus.glb` is what `support::model::sample_glb` writes (regenerate with
 /// `SPLITSUM_WRITE_ASSETS=1 cargo test -p splitsum-tests --test model`).
 #[test]
 fn committed_sample_model_is_current() {
@@ -18,7 +18,7 @@ fn committed_sample_model_is_current() {
     if std::env::var_os("SPLITSUM_WRITE_ASSETS").is_some() {
         std::fs::write(sample_path(), &fresh).unwrap();
     }
-    assert!(std::fs::read(sample_path()).unwrap() == fresh, "assets/models/torus.glb is stale");
+    assert!(std::fs::read(sample_path()).unwrap() == fresh, "display/assets/torus.glb is stale");
 }
 
 #[test]

@@ -22,7 +22,7 @@ fn assets() -> PathBuf {
 /// A scene over the vendored courtyard, with `body` (materials, objects, quality …) after
 /// the top-level keys in `head`.
 fn scene(head: &str, body: &str) -> Scene {
-    let env = assets().join("environments/courtyard.exr");
+    let env = support::environment_path("courtyard");
     let text = format!("environment = {:?}\n{head}\n{body}", env.display().to_string());
     Scene::parse(&text).unwrap_or_else(|e| panic!("{e}\n{text}"))
 }
@@ -191,7 +191,7 @@ fn the_calibration_reads_a_report() {
 const QUICK: &str = "[quality]\nsize = 32\nsamples = 32\nlut_size = 16\nlut_samples = 32\nirradiance_source = 8";
 
 fn environment() -> Environment {
-    splitsum::environment::load(&assets().join("environments/courtyard.exr"), false).unwrap().0
+    splitsum::environment::load(&support::environment_path("courtyard"), false).unwrap().0
 }
 
 /// The plan's bake and the full bake at the same settings (every product, every mip).
@@ -229,7 +229,7 @@ fn max_abs(a: &[Vec4], b: &[Vec4]) -> f32 {
 #[test]
 fn renders_from_reduced_bakes_equal_renders_from_full_bakes() {
     let env = environment();
-    let torus = assets().join("models/torus.glb");
+    let torus = assets().join("../display/assets/torus.glb");
     let cases = [
         ("metals", String::new(), material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]\nbase_color = [0.9, 0.9, 0.9]")),
         ("clay", String::new(), material("clay", "specular = \"none\"\ndiffuse = \"oren-nayar\"\nroughness = 0.8")),

@@ -35,7 +35,7 @@
 //!
 //! [[objects]]
 //! kind = "gltf"
-//! path = "assets/models/torus.glb"
+//! path = "models/torus.glb"
 //! material = "gold"                               # models, and ranges the textures are clamped to
 //!
 //! [[lights]]

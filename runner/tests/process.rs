@@ -129,7 +129,7 @@ fn the_gpu_backend_takes_inputs_beyond_its_binding_limit() {
 }
 
 fn courtyard() -> String {
-    format!("{}/../assets/environments/courtyard.exr", env!("CARGO_MANIFEST_DIR"))
+    format!("{}/../splitsum/assets/courtyard.exr", env!("CARGO_MANIFEST_DIR"))
 }
 
 fn listing(dir: &Path) -> Vec<String> {
@@ -486,7 +486,7 @@ fn hostile_headers_stay_within_memory_bounds() {
         c
     };
     let torus = d.join("torus.glb");
-    std::fs::write(&torus, std::fs::read(format!("{}/../assets/models/torus.glb", env!("CARGO_MANIFEST_DIR"))).unwrap()).unwrap();
+    std::fs::write(&torus, std::fs::read(format!("{}/../display/assets/torus.glb", env!("CARGO_MANIFEST_DIR"))).unwrap()).unwrap();
     let (ok, said, model_baseline) = run_measured(render(&torus), &d);
     assert!(ok, "{said}");
     let mut models: Vec<(String, PathBuf, &str)> = Vec::new();

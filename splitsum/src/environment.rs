@@ -819,10 +819,12 @@ impl Reducer {
 }
 
 /// The environment `runner` shows when given none: Greg Zaal's "courtyard" (CC0, see
-/// `assets/environments/LICENSE.md`), embedded in the binary.
-pub static EMBEDDED_DEFAULT: &[u8] = include_bytes!("../../assets/environments/courtyard.exr");
+/// `assets/LICENSE.md`), embedded in the binary with the `embedded-environment` feature.
+#[cfg(feature = "embedded-environment")]
+pub static EMBEDDED_DEFAULT: &[u8] = include_bytes!("../assets/courtyard.exr");
 
 /// Decodes [`EMBEDDED_DEFAULT`].
+#[cfg(feature = "embedded-environment")]
 pub fn embedded_default() -> Result<Environment> {
     let path = Path::new("<embedded courtyard.exr>");
     let (image, _) = read_exr(path, std::io::Cursor::new(EMBEDDED_DEFAULT), EMBEDDED_DEFAULT.len() as u64, Weights::EquirectRows, false, 1)?;
@@ -834,9 +836,12 @@ pub fn embedded_default() -> Result<Environment> {
 pub fn identity(path: Option<&Path>) -> Result<[u8; 32]> {
     let mut h = blake3::Hasher::new();
     match path {
+        #[cfg(feature = "embedded-environment")]
         None => {
             h.update(EMBEDDED_DEFAULT);
         }
+        #[cfg(not(feature = "embedded-environment"))]
+        None => return Err(Error::Invalid("no environment given, and splitsum was built without the embedded default (feature embedded-environment)".into())),
         Some(p) => {
             let files = if p.is_dir() { face_paths(p)?.to_vec() } else { vec![p.to_path_buf()] };
             for f in files {

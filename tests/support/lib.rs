@@ -62,9 +62,16 @@ pub fn max_diffs(a: impl IntoIterator<Item = f32>, b: impl IntoIterator<Item = f
     (abs, ulp)
 }
 
-/// One of the vendored CC0 environments (`assets/environments/NAME.exr`), as an equirect.
+/// The path of a vendored CC0 environment: `assets/environments/NAME.exr`, or
+/// `splitsum/assets/courtyard.exr` (the one the library embeds).
+pub fn environment_path(name: &str) -> std::path::PathBuf {
+    let root = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    if name == "courtyard" { root.join("splitsum/assets/courtyard.exr") } else { root.join("assets/environments").join(format!("{name}.exr")) }
+}
+
+/// One of the vendored CC0 environments ([`environment_path`]), as an equirect.
 pub fn environment(name: &str) -> splitsum::texture::Equirect {
-    let path = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/environments").join(format!("{name}.exr"));
+    let path = environment_path(name);
     match splitsum::environment::load(&path, false).expect("vendored environment") {
         (splitsum::environment::Environment::Equirect(e), _) => e,
         _ => unreachable!(),

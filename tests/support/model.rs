@@ -1,7 +1,7 @@
 //! A procedural glTF 2.0 test model: a torus with all five metallic–roughness texture
 //! slots filled (base colour checker, roughness ramp and metal cells, dimpled normal map,
 //! grooves in the occlusion, glowing dots), a node transform, written as a `.glb`.
-//! `assets/models/torus.glb` is this output (checked by a test).
+//! `display/assets/torus.glb` is this output (checked by a test).
 
 use std::f32::consts::TAU;
 
