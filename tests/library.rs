@@ -20,7 +20,22 @@ fn device() -> &'static (wgpu::Device, wgpu::Queue) {
 }
 
 fn small() -> Settings {
-    Settings { size: 16, source_size: 32, mips: Settings::default_mips(16), lut_size: 128, irradiance_size: 8, ..Settings::default() }
+    Settings { size: 16, source_size: Some(32), lut_size: 128, irradiance_size: 8, ..Settings::default() }
+}
+
+/// What `Ibl::read` gives, unwrapped: the two cubes and the table as `(A, B, 0, 0)`.
+struct Data {
+    specular: splitsum::texture::Cube,
+    irradiance: splitsum::texture::Cube,
+    brdf: Vec<Vec4>,
+}
+
+fn data(b: splitsum::Baked) -> Data {
+    Data {
+        specular: b.specular.expect("read back"),
+        irradiance: b.irradiance.expect("read back"),
+        brdf: b.lut.expect("read back").texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect(),
+    }
 }
 
 fn constant(l: f32) -> Environment {
@@ -62,8 +77,8 @@ fn textures_baked_on_the_device_match_those_baked_on_the_cpu() {
     let (d, q) = device();
     let env = splitsum::environment::embedded_default().unwrap();
     let s = small();
-    let gpu = Baker::new(d, q, Compute::Gpu).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
-    let cpu = Baker::new(d, q, Compute::Cpu).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
+    let gpu = Baker::new(d, q, Compute::Gpu).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).map(data).unwrap();
+    let cpu = Baker::new(d, q, Compute::Cpu).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).map(data).unwrap();
     let compare = |what: &str, a: &[Vec4], b: &[Vec4]| {
         assert_eq!(a.len(), b.len(), "{what}");
         let peak = b.iter().map(|v| v.max_element()).fold(0.0f32, f32::max);
@@ -72,7 +87,7 @@ fn textures_baked_on_the_device_match_those_baked_on_the_cpu() {
         eprintln!("{what}: GPU vs CPU textures, largest relative difference {worst:.2e}");
         assert!(worst <= 2.0f32.powi(-10), "{what}: GPU and CPU textures differ by {worst:.2e} relative");
     };
-    assert_eq!(gpu.specular.layout.levels, s.mips, "a mip per roughness");
+    assert_eq!(gpu.specular.layout.levels, Settings::default_mips(16), "a mip per roughness, derived from the size");
     compare("specular", &gpu.specular.texels, &cpu.specular.texels);
     compare("irradiance", &gpu.irradiance.texels, &cpu.irradiance.texels);
     compare("brdf", &gpu.brdf, &cpu.brdf);
@@ -95,7 +110,7 @@ fn a_sun_beyond_half_floats_stays_finite_in_the_textures() {
     texels[10 * 64 + 20] = Vec4::new(1e6, 1e6, 1e6, 1.0);
     let env = Environment::Equirect(Equirect { width: 64, height: 32, texels });
     for compute in [Compute::Gpu, Compute::Cpu] {
-        let data = Baker::new(d, q, compute).unwrap().bake(Source::Environment(&env), &small()).unwrap().read(d, q).unwrap();
+        let data = Baker::new(d, q, compute).unwrap().bake(Source::Environment(&env), &small()).unwrap().read(d, q).map(data).unwrap();
         let max = data.specular.texels.iter().map(|v| v.max_element()).fold(0.0f32, f32::max);
         assert!(data.specular.texels.iter().all(|v| v.is_finite()), "{compute:?}: every texel finite");
         assert_eq!(max, 65504.0, "{compute:?}: the sun's mirror texel is clamped to the largest half");
@@ -133,8 +148,8 @@ fn a_texture_source_bakes_what_the_same_host_data_bakes() {
     };
     let baker = Baker::new(d, q, Compute::Gpu).unwrap();
     let equirect = upload(e.width, e.height, 1, wgpu::TextureFormat::Rgba32Float, bytemuck::cast_slice(&e.texels));
-    let from_texture = baker.bake(Source::Texture(&equirect), &s).unwrap().read(d, q).unwrap();
-    let from_host = baker.bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
+    let from_texture = baker.bake(Source::Texture(&equirect), &s).unwrap().read(d, q).map(data).unwrap();
+    let from_host = baker.bake(Source::Environment(&env), &s).unwrap().read(d, q).map(data).unwrap();
     assert_eq!(from_texture.specular.texels, from_host.specular.texels, "equirect texture vs host data");
     assert_eq!(from_texture.irradiance.texels, from_host.irradiance.texels);
 
@@ -148,8 +163,8 @@ fn a_texture_source_bakes_what_the_same_host_data_bakes() {
     let texture = upload(face, face, 6, wgpu::TextureFormat::Rgba16Float, bytemuck::cast_slice(&bits));
     for compute in [Compute::Gpu, Compute::Cpu] {
         let baker = Baker::new(d, q, compute).unwrap();
-        let a = baker.bake(Source::Texture(&texture), &s).unwrap().read(d, q).unwrap();
-        let b = baker.bake(Source::Environment(&host), &s).unwrap().read(d, q).unwrap();
+        let a = baker.bake(Source::Texture(&texture), &s).unwrap().read(d, q).map(data).unwrap();
+        let b = baker.bake(Source::Environment(&host), &s).unwrap().read(d, q).map(data).unwrap();
         assert_eq!(a.specular.texels, b.specular.texels, "{compute:?}: cube texture vs host data");
         assert_eq!(a.irradiance.texels, b.irradiance.texels, "{compute:?}");
     }
@@ -187,13 +202,14 @@ fn the_baker_takes_an_engine_target() {
     let mut texels = vec![Vec4::new(0.01, 0.01, 0.01, 1.0); w * h];
     texels[py * w + px] = Vec4::new(5000.0, 5000.0, 5000.0, 1.0);
     let env = Environment::Equirect(Equirect { width: w as u32, height: h as u32, texels });
-    let s = Settings { size: 32, source_size: 32, irradiance_size: 8, lut_size: 32, ..Settings::default() }.with_target(splitsum::Target::Khronos);
-    assert_eq!((s.mips, s.roughness()[1]), (5, 0.25), "floor(log2 32) mips at m/(M - 1)");
+    let s = Settings { size: 32, irradiance_size: 8, lut_size: 32, ..Settings::default() }.with_target(splitsum::Target::Khronos);
+    let job = s.resolve(splitsum::settings::InputShape::of(&env), splitsum::Products::DISPLAY).unwrap();
+    assert_eq!((job.mips, job.roughness_per_mip[1]), (5, 0.25), "floor(log2 32) mips at m/(M - 1)");
     let (u, v) = ((px as f64 + 0.5) / w as f64, (py as f64 + 0.5) / h as f64);
     let (phi, theta) = (std::f64::consts::TAU * (u - 0.5), std::f64::consts::PI * v);
     let want = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];
     for compute in [Compute::Gpu, Compute::Cpu] {
-        let data = Baker::new(d, q, compute).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).unwrap();
+        let data = Baker::new(d, q, compute).unwrap().bake(Source::Environment(&env), &s).unwrap().read(d, q).map(self::data).unwrap();
         assert_eq!(data.specular.layout.levels, 5);
         let level = data.specular.level(0);
         let k = (0..level.len()).max_by(|&a, &b| level[a].x.total_cmp(&level[b].x)).unwrap() as u32;

@@ -7,7 +7,7 @@ use splitsum::bake::BakedEnvironment;
 use splitsum::cache::{Cache, Lookup};
 use splitsum::cost::Calibration;
 use splitsum::environment::Environment;
-use splitsum::settings::Products;
+use splitsum::settings::{InputShape, Products};
 use splitsum_display::plan::{self, Plan};
 use splitsum_display::prepare::{self as bake, Outcome};
 use splitsum_display::scene::Scene;
@@ -33,7 +33,7 @@ fn material(name: &str, fields: &str) -> String {
 
 /// The plan over a 256² environment of width 1024 (the vendored ones).
 fn planned(s: &Scene) -> Plan {
-    plan::plan(s, 256, 1024, &Calibration::default())
+    plan::plan(s, 256, InputShape::Equirect { width: 1024, height: 512 }, &Calibration::default()).unwrap()
 }
 
 fn skipped(p: &Plan, what: &str) -> bool {
@@ -43,10 +43,10 @@ fn skipped(p: &Plan, what: &str) -> bool {
 #[test]
 fn a_full_scene_keeps_everything() {
     let p = planned(&scene("", &material("all", "metallic = [0.0, 1.0]\nroughness = [0.0, 1.0]")));
-    assert_eq!((p.products.specular, p.products.lut, p.products.irradiance), (true, true, true));
-    assert_eq!(p.levels, (0..p.settings.mips).collect::<Vec<_>>());
-    assert_eq!(p.settings.size, 256, "roughness 0 needs the environment's full resolution");
-    assert!(!p.products.sh9, "the display reads the irradiance cube, not SH9");
+    assert_eq!((p.job.products.specular, p.job.products.lut, p.job.products.irradiance), (true, true, true));
+    assert_eq!(p.job.levels, (0..p.job.mips).collect::<Vec<_>>());
+    assert_eq!(p.job.size, 256, "roughness 0 needs the environment's full resolution");
+    assert!(!p.job.products.sh9, "the display reads the irradiance cube, not SH9");
     assert!((p.cost.cpu_seconds - p.full_cost.cpu_seconds).abs() < 1e-9);
 }
 
@@ -54,8 +54,8 @@ fn a_full_scene_keeps_everything() {
 fn no_specular_image_light_drops_the_prefilter_and_the_table() {
     for fields in ["specular = \"none\"", "specular = \"none\"\ndiffuse = \"oren-nayar\""] {
         let p = planned(&scene("", &material("clay", fields)));
-        assert!(!p.products.specular && !p.products.lut && p.products.irradiance, "{fields}: {p:?}");
-        assert!(p.levels.is_empty());
+        assert!(!p.job.products.specular && !p.job.products.lut && p.job.products.irradiance, "{fields}: {p:?}");
+        assert!(p.job.levels.is_empty());
         assert!(skipped(&p, "prefiltered specular cube") && skipped(&p, "BRDF table"));
         assert!(p.cost.cpu_seconds < p.full_cost.cpu_seconds);
     }
@@ -64,18 +64,18 @@ fn no_specular_image_light_drops_the_prefilter_and_the_table() {
 #[test]
 fn a_blurred_sky_keeps_only_the_mips_it_reads() {
     let p = planned(&scene("sky_blur = 2.5", &material("clay", "specular = \"none\"")));
-    assert!(p.products.specular && !p.products.lut);
-    assert_eq!(p.levels, vec![2, 3]);
+    assert!(p.job.products.specular && !p.job.products.lut);
+    assert_eq!(p.job.levels, vec![2, 3]);
 }
 
 #[test]
 fn only_metals_drop_the_irradiance() {
     let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.0, 1.0]")));
-    assert!(p.products.specular && p.products.lut && !p.products.irradiance);
+    assert!(p.job.products.specular && p.job.products.lut && !p.job.products.irradiance);
     assert!(skipped(&p, "irradiance cube"));
     // A metalness range that reaches below 1 needs it again.
     let p = planned(&scene("", &material("alloy", "metallic = [0.9, 1.0]")));
-    assert!(p.products.irradiance);
+    assert!(p.job.products.irradiance);
 }
 
 #[test]
@@ -85,37 +85,37 @@ fn a_roughness_range_keeps_the_mips_around_it() {
     // lod 1.68 and r = 0.7 (α = 0.49) lod 2.49: mips 1, 2 and 3 (trilinear filtering's
     // upper neighbour).
     let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
-    assert_eq!(p.settings.mips, 4);
-    assert_eq!(p.levels, vec![1, 2, 3]);
+    assert_eq!(p.job.mips, 4);
+    assert_eq!(p.job.levels, vec![1, 2, 3]);
     assert!(skipped(&p, "specular mips"));
     // A single roughness: 0.6 (α = 0.36) on a 32² cube (M = 3) reads lod 1 + (log₂0.36 + 3)/3
     // = 1.51: mips 1 and 2.
     let p = planned(&scene("", &material("satin", "roughness = 0.6")));
-    assert_eq!((p.settings.size, p.levels.clone()), (32, vec![1, 2]));
+    assert_eq!((p.job.size, p.job.levels.clone()), (32, vec![1, 2]));
     // Two materials: the union of their mips. r = 0.2 needs the 256² cube (M = 6, lod 1.90);
     // r = 0.85 and 0.9 read lod 4.69 and 4.80.
     let two = format!("{}{}", material("a", "roughness = 0.2"), material("b", "roughness = [0.85, 0.9]"));
-    assert_eq!(planned(&scene("", &two)).levels, vec![1, 2, 4, 5]);
+    assert_eq!(planned(&scene("", &two)).job.levels, vec![1, 2, 4, 5]);
 }
 
 #[test]
 fn phong_and_blinn_phong_need_no_ggx_table() {
     for model in ["phong", "blinn-phong"] {
         let p = planned(&scene("", &material("plastic", &format!("specular = {model:?}\nroughness = [0.2, 0.6]"))));
-        assert!(p.products.specular && p.products.irradiance && !p.products.lut, "{model}");
+        assert!(p.job.products.specular && p.job.products.irradiance && !p.job.products.lut, "{model}");
         assert!(skipped(&p, "BRDF table"));
     }
     // One Cook–Torrance material among them brings it back.
     let two = format!("{}{}", material("a", "specular = \"phong\""), material("b", "specular = \"cook-torrance\""));
-    assert!(planned(&scene("", &two)).products.lut);
+    assert!(planned(&scene("", &two)).job.products.lut);
 }
 
 #[test]
 fn no_image_light_bakes_nothing() {
     for body in [material("unlit", "ibl = false"), String::new()] {
         let p = planned(&scene("", &body));
-        assert!(!p.products.specular && !p.products.lut && !p.products.irradiance && !p.products.sh9);
-        assert!(p.levels.is_empty());
+        assert!(!p.job.products.specular && !p.job.products.lut && !p.job.products.irradiance && !p.job.products.sh9);
+        assert!(p.job.levels.is_empty());
         assert!(skipped(&p, "everything"));
     }
 }
@@ -126,21 +126,21 @@ fn the_smallest_roughness_and_the_output_set_the_cube_size() {
     // in the mip it reads. On a 32² cube (M = 3) it reads lod 1.12, mip 1 of 16² (texel
     // π/2 / 16 = 0.098: too coarse); on a 64² cube (M = 4) lod 1.68, mip 1 of 32² (0.049).
     let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
-    assert_eq!(p.settings.size, 64);
+    assert_eq!(p.job.size, 64);
     // Rougher still: r ≥ 0.8, half its lobe 0.32 rad. An 8² cube (M = 2: the mirror and
     // r = 1) reads mip 1 of 4² (0.39 rad, too coarse); a 16² cube mip 1 of 8² (0.196 rad).
     let p = planned(&scene("", &material("rough", "roughness = [0.8, 1.0]")));
-    assert_eq!(p.settings.size, 16);
+    assert_eq!(p.job.size, 16);
     // A mirror needs a pixel's resolution, capped by the environment's own.
     let mirror = material("mirror", "metallic = 1.0\nroughness = 0.0");
-    assert_eq!(planned(&scene("", &mirror)).settings.size, 256);
-    assert_eq!(plan::plan(&scene("", &mirror), 64, 256, &Calibration::default()).settings.size, 64);
+    assert_eq!(planned(&scene("", &mirror)).job.size, 256);
+    assert_eq!(plan::plan(&scene("", &mirror), 64, InputShape::Equirect { width: 256, height: 128 }, &Calibration::default()).unwrap().job.size, 64);
     // A tiny output: 30 pixels over 45° are 0.026 rad each; mip 0 of a 64² cube has
     // texels of 0.0245 rad, of a 32² cube 0.049 rad.
     let tiny = scene("[output]\nwidth = 30\nheight = 30", &mirror);
-    assert_eq!(planned(&tiny).settings.size, 64);
+    assert_eq!(planned(&tiny).job.size, 64);
     // [quality] size overrides.
-    assert_eq!(planned(&scene("", &format!("{mirror}\n[quality]\nsize = 32"))).settings.size, 32);
+    assert_eq!(planned(&scene("", &format!("{mirror}\n[quality]\nsize = 32"))).job.size, 32);
 }
 
 #[test]
@@ -153,24 +153,24 @@ fn a_maximum_error_picks_the_cheapest_settings_that_meet_it() {
     // 0.625, 0.875 and 1; 16 samples at mip 1 give at most 0.0998 (at r 0.2–0.35). The
     // irradiance: the 4² level (0.035). The table is by quadrature (within 1e-5), whatever
     // the target.
-    assert_eq!((loose.settings.samples, loose.settings.irradiance_source), (16, 4));
-    assert_eq!(loose.settings.lut_method, splitsum::settings::TableMethod::Quadrature);
+    assert_eq!((loose.job.samples, loose.job.irradiance_source), (16, 4));
+    assert_eq!(loose.job.lut_method, splitsum::settings::TableMethod::Quadrature);
     // Tight: no measured count reaches 0.05 at r 0.2–0.35 (256 give 0.0596: mip
     // interpolation, not sampling, is what is left), and the plan says so; the irradiance
     // from 4² still meets it (0.035).
-    assert_eq!((tight.settings.samples, tight.settings.irradiance_source), (256, 4));
+    assert_eq!((tight.job.samples, tight.job.irradiance_source), (256, 4));
     let strict = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.01")));
     // At 0.01 the irradiance needs the 16² level (0.0067; 8² gives 0.0181).
-    assert_eq!(strict.settings.irradiance_source, 16);
-    assert_eq!(tight.settings.lut_method, splitsum::settings::TableMethod::Quadrature);
+    assert_eq!(strict.job.irradiance_source, 16);
+    assert_eq!(tight.job.lut_method, splitsum::settings::TableMethod::Quadrature);
     // A sample count in the scene asks for the sampled table.
     let sampled = planned(&scene("", &format!("{body}\n[quality]\nlut_samples = 64")));
-    assert_eq!((sampled.settings.lut_method, sampled.settings.lut_samples), (splitsum::settings::TableMethod::Sampled, 64));
+    assert_eq!((sampled.job.lut_method, sampled.job.lut_samples), (splitsum::settings::TableMethod::Sampled, 64));
     assert!(tight.decisions.iter().any(|d| d.what == "prefilter samples" && d.why.contains("still above")));
     assert!(tight.cost.cpu_seconds > 2.0 * loose.cost.cpu_seconds);
     // Fixed settings are kept as given.
     let fixed = planned(&scene("", &format!("{body}\n[quality]\nmax_error = 0.05\nsamples = 77")));
-    assert_eq!(fixed.settings.samples, 77);
+    assert_eq!(fixed.job.samples, 77);
 }
 
 #[test]
@@ -196,11 +196,10 @@ fn environment() -> Environment {
 
 /// The plan's bake and the full bake at the same settings (every product, every mip).
 fn reduced_and_full(s: &Scene, env: &Environment) -> (Plan, BakedEnvironment, BakedEnvironment) {
-    let p = plan::plan_for(s, env, &Calibration::default());
+    let p = plan::plan_for(s, env, &Calibration::default()).unwrap();
     let (reduced, _) = bake::bake_plan(&Backend::Cpu, env, &p).unwrap();
     let mut all = p.clone();
-    all.products = Products::ALL;
-    all.levels = (0..p.settings.mips).collect();
+    all.job = p.job.given.resolve(InputShape::of(env), Products::ALL).unwrap();
     let (full, _) = bake::bake_plan(&Backend::Cpu, env, &all).unwrap();
     (p, reduced, full)
 }
@@ -249,11 +248,11 @@ fn renders_from_reduced_bakes_equal_renders_from_full_bakes() {
     for (name, head, body) in cases {
         let s = scene(&head, &format!("{body}\n{QUICK}\n[[lights]]\nkind = \"directional\"\ndirection = [0.3, 1.0, 0.5]\nradiance = [2.0, 2.0, 2.0]"));
         let (p, reduced, full) = reduced_and_full(&s, &env);
-        let left_out = !(p.products.specular && p.products.lut && p.products.irradiance) || p.levels.len() < p.settings.mips as usize;
+        let left_out = !(p.job.products.specular && p.job.products.lut && p.job.products.irradiance) || p.job.levels.len() < p.job.mips as usize;
         assert!(left_out, "{name}: the plan should leave something out");
         let cpu = max_abs(&render(&s, &reduced, &Backend::Cpu), &render(&s, &full, &Backend::Cpu));
         let lava = max_abs(&render(&s, &reduced, gpu), &render(&s, &full, gpu));
-        println!("{name}: levels {:?} of {}, products {:?}: reduced vs full, CPU {cpu:e}, GPU {lava:e}", p.levels, p.settings.mips, p.products);
+        println!("{name}: levels {:?} of {}, products {:?}: reduced vs full, CPU {cpu:e}, GPU {lava:e}", p.job.levels, p.job.mips, p.job.products);
         assert_eq!(cpu, 0.0, "{name}: the reduced bake changed the CPU render");
         assert!(lava <= 1e-6, "{name}: the reduced bake changed the GPU render by {lava}");
     }
@@ -406,7 +405,7 @@ fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
     let args = ["runner", "bake", "--scene", file.to_str().unwrap(), "--backend", "cpu", "--cache", cache.to_str().unwrap(), "--out", out.to_str().unwrap()];
     runner::cli::run(args).expect("first bake");
     let plan_json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
-    assert_eq!(plan_json["plan"]["products"]["irradiance"], false);
+    assert_eq!(plan_json["plan"]["job"]["products"]["irradiance"], false);
     assert!(out.join("specular.ktx2").exists() && out.join("brdf_lut.exr").exists());
     assert!(!out.join("irradiance.ktx2").exists(), "left-out products are not written");
     // specular.ktx2 holds mips 1 … 2 of the 32² cube (M = 3: r = 0, √⅛, 1; r ∈ [0.4, 0.7]

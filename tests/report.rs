@@ -57,7 +57,7 @@ fn end_to_end_measure_of_a_constant_sky() {
     use splitsum_report::accuracy::{Method, Points};
     use splitsum_shaders::glam::Vec4;
     let env = Environment::Equirect(Equirect { width: 64, height: 32, texels: vec![Vec4::new(0.5, 1.0, 2.0, 1.0); 64 * 32] });
-    let settings = Settings { size: 16, source_size: 16, ..Settings::default() }.fitted();
+    let settings = Settings { size: 16, source_size: Some(16), ..Settings::default() };
     let source = splitsum::bake::host_source_cube(&splitsum::Backend::Cpu, &env, &settings).unwrap();
     let points = Points::new(&source, 48, 32);
     let methods = [Method { label: "defaults".into(), family: "defaults", settings, flags: splitsum_shaders::shade::ShadeOptions::DEFAULT.flags }];

@@ -22,8 +22,8 @@
 use crate::scene::{MaterialSpec, Scene};
 use serde::Serialize;
 use splitsum::cost::{Calibration, Cost, estimate};
-use splitsum::settings::{Products, Settings, TableMethod};
-use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum::error::Result;
+use splitsum::settings::{InputShape, Job, Products, Settings, TableMethod};
 use splitsum_shaders::shade::SpecularModel;
 
 /// One decision of the plan.
@@ -40,17 +40,15 @@ pub struct Decision {
 /// What to bake.
 #[derive(Clone, Debug, Serialize)]
 pub struct Plan {
-    /// Every setting.
-    pub settings: Settings,
-    /// Which products.
-    pub products: Products,
-    /// The specular mips to bake (the others stay empty: nothing reads them).
-    pub levels: Vec<u32>,
+    /// The bake: every setting resolved, the products and the specular mips it keeps (the
+    /// others stay empty: nothing reads them).
+    pub job: Job,
     /// Why each product is kept or left out, and each setting chosen.
     pub decisions: Vec<Decision>,
     /// The plan's cost.
     pub cost: Cost,
-    /// A full bake's cost at the same settings (every product, every mip).
+    /// A full bake's cost at the same settings (every product the display reads, every
+    /// mip).
     pub full_cost: Cost,
     /// The cost of `runner bake ENV` at its defaults (every product at 256²): what baking
     /// without a plan costs.
@@ -64,17 +62,13 @@ pub fn mip_count(size: u32) -> u32 {
 }
 
 /// Plans the bake of `scene` over the loaded environment `env`.
-pub fn plan_for(scene: &Scene, env: &splitsum::environment::Environment, cal: &Calibration) -> Plan {
-    let width = match env {
-        splitsum::environment::Environment::Equirect(e) => e.width,
-        splitsum::environment::Environment::Cube(c) => 4 * c.layout.size,
-    };
-    plan(scene, env.native_face_size(), width, cal)
+pub fn plan_for(scene: &Scene, env: &splitsum::environment::Environment, cal: &Calibration) -> Result<Plan> {
+    plan(scene, env.native_face_size(), InputShape::of(env), cal)
 }
 
 /// Plans the bake of `scene` over an environment of face size `native` (see
-/// `Environment::native_face_size`) and equirect width `width` (for the resampling cost).
-pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
+/// `Environment::native_face_size`) and shape `shape` (for the resampling cost).
+pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) -> Result<Plan> {
     let mut d: Vec<Decision> = Vec::new();
     let mut decide = |what: &str, kept: bool, why: String| d.push(Decision { what: what.into(), kept, why });
     let used = scene.used_materials();
@@ -91,7 +85,7 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     let alpha = (r_min * r_min) as f64;
     let texel = if specular_ibl.is_empty() { pixel.max(0.25) } else { pixel.max(0.5 * alpha) };
     let defaults = Settings::default();
-    let mapping: RoughnessMapping = defaults.mapping.into();
+    let mapping = defaults.resolve(shape, Products::ALL)?.mapping;
     let finest_read = |size: u32| -> u32 {
         let mips = mip_count(size);
         size >> (mapping.lod(r_min, mips).floor() as u32).min(mips - 1)
@@ -104,14 +98,8 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     }
     let size = scene.quality.size.unwrap_or(wanted.min(native));
     let mips = mip_count(size);
-    let mut settings = Settings {
-        size,
-        source_size: native.max(size),
-        mips,
-        irradiance_source: defaults.irradiance_source.min(native.max(size)),
-        sh_source: defaults.sh_source.min(native.max(size)),
-        ..defaults
-    };
+    let source_size = native.max(size);
+    let mut settings = Settings { size, source_size: Some(source_size), ..defaults };
     if !specular_ibl.is_empty() {
         let why = if scene.quality.size.is_some() {
             "as [quality] size asks".to_string()
@@ -218,31 +206,28 @@ pub fn plan(scene: &Scene, native: u32, width: u32, cal: &Calibration) -> Plan {
     if let Some(n) = q.lut_samples {
         settings.lut_samples = n;
         settings.lut_method = TableMethod::Sampled;
-        settings.lut_masking = settings.lut_method.default_masking();
     } else if let (Some(e), true) = (target, lut) {
         decide("BRDF table method", true, format!("quadrature: max error 1e-5 at every texel ≤ {e}"));
     }
     settings.lut_size = q.lut_size.unwrap_or(settings.lut_size);
     settings.irradiance_source = match (q.irradiance_source, target) {
-        (Some(s), _) => s,
+        (Some(s), _) => Some(s),
         (None, Some(e)) if irradiance => {
             // Only the levels the source cube has.
-            let sources: Vec<(u32, f64)> = cal.irradiance.iter().copied().filter(|&(s, _)| s <= settings.source_size).collect();
+            let sources: Vec<(u32, f64)> = cal.irradiance.iter().copied().filter(|&(s, _)| s <= source_size).collect();
             let (s, why) = cheapest(&sources, e, |s| format!("{s}×{s} source level"));
             decide("irradiance source", true, why);
-            s
+            Some(s)
         }
         _ => settings.irradiance_source,
     };
 
     let products = Products { specular, irradiance, sh9: false, lut };
-    let cost = estimate(&settings, products, &levels, width, cal);
-    let all_levels: Vec<u32> = (0..mips).collect();
-    let full_cost = estimate(&settings, Products::ALL, &all_levels, width, cal);
-    let default_settings = Settings::default();
-    let default_levels: Vec<u32> = (0..default_settings.mips).collect();
-    let default_cost = estimate(&default_settings, Products::ALL, &default_levels, width, cal);
-    Plan { settings, products, levels, decisions: d, cost, full_cost, default_cost }
+    let job = settings.resolve(shape, products)?.with_levels(levels)?;
+    let cost = estimate(&job, cal);
+    let full_cost = estimate(&settings.resolve(shape, Products::DISPLAY)?, cal);
+    let default_cost = estimate(&Settings::default().resolve(shape, Products::ALL)?, cal);
+    Ok(Plan { job, decisions: d, cost, full_cost, default_cost })
 }
 
 /// The first (cheapest) setting of `table` whose error meets `target`, else the last (the
@@ -268,8 +253,8 @@ pub fn describe(plan: &Plan, scene: &str, environment: &str) -> String {
     for d in plan.decisions.iter().filter(|d| !d.kept) {
         let _ = writeln!(out, "  skip   {:<26} {}", d.what, d.why);
     }
-    let s = &plan.settings;
-    let p = plan.products;
+    let s = &plan.job;
+    let p = s.products;
     let mut kept = vec![format!("source {}²", s.source_size)];
     if p.specular {
         kept.push(format!("specular {}² × {} mips ({:?}), {} samples, bias {}", s.size, s.mips, s.mapping, s.samples, s.lod_bias));
@@ -292,7 +277,7 @@ pub fn describe(plan: &Plan, scene: &str, environment: &str) -> String {
         )
     };
     let _ = writeln!(out, "  estimate: {}", line(plan.cost));
-    let _ = writeln!(out, "            every product and mip at these settings: {}", line(plan.full_cost));
+    let _ = writeln!(out, "            every displayed product and mip, same settings: {}", line(plan.full_cost));
     let _ = writeln!(out, "            `runner bake ENV` at its defaults:        {}", line(plan.default_cost));
     out
 }

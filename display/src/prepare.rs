@@ -3,7 +3,7 @@
 //! build is there.
 
 use splitsum::Backend;
-use splitsum::bake::{BakedEnvironment, Timing, bake_levels, check_duration, step_estimates};
+use splitsum::bake::{BakedEnvironment, Timing, bake_job, check_duration, step_estimates};
 use splitsum::error::Result;
 
 /// What happened to a scene's bake.
@@ -35,9 +35,9 @@ pub struct SceneBake {
 
 /// Bakes what `plan` keeps of `env` into what the display reads (stand-ins for the rest).
 pub fn bake_plan(backend: &Backend, env: &splitsum::Environment, plan: &crate::plan::Plan) -> Result<(BakedEnvironment, Vec<Timing>)> {
-    let baked = bake_levels(backend, env, &plan.settings, plan.products, &plan.levels)?;
+    let baked = bake_job(backend, env, &plan.job)?;
     let timings = baked.timings.clone();
-    Ok((baked.into_display(plan.settings.mapping), timings))
+    Ok((baked.into_display(plan.job.mapping), timings))
 }
 
 /// Plans `scene` and bakes it, or takes it from `cache` when an entry for exactly this
@@ -55,8 +55,8 @@ pub fn bake_scene(
         None => (splitsum::environment::embedded_default()?, Default::default()),
     };
     let identity = splitsum::environment::identity(env_path.as_deref())?;
-    let plan = crate::plan::plan_for(scene, &env, cal);
-    let plan_json = serde_json::to_string(&(&plan.settings, &plan.products, &plan.levels, scene.sanitize)).expect("serialisable");
+    let plan = crate::plan::plan_for(scene, &env, cal)?;
+    let plan_json = serde_json::to_string(&(&plan.job, scene.sanitize)).expect("serialisable");
     let key = splitsum::cache::key(&identity, &plan_json, &backend.identity());
     let mut outcome = if force { Outcome::Forced } else { Outcome::Baked };
     // Held until this bake is stored: a concurrent run of the same key waits, then hits.
@@ -69,7 +69,7 @@ pub fn bake_scene(
             splitsum::cache::Lookup::Foreign(e) => return Err(e),
         }
     }
-    check_duration(&step_estimates(backend.is_gpu(), &env, &plan.settings, plan.products, &plan.levels), force)?;
+    check_duration(&step_estimates(backend.is_gpu(), &plan.job), force)?;
     let (baked, timings) = bake_plan(backend, &env, &plan)?;
     if let Some(c) = cache {
         c.put(&key, &baked)?;

@@ -411,15 +411,12 @@ impl Scene {
         // `Settings::validate`, which names them as the scene does.
         let q = &self.quality;
         let d = splitsum::Settings::default();
-        let size = q.size.unwrap_or(d.size);
         let settings = splitsum::Settings {
-            size,
-            source_size: d.source_size.max(size),
-            mips: splitsum::Settings::default_mips(size),
+            size: q.size.unwrap_or(d.size),
             samples: q.samples.unwrap_or(d.samples),
             lut_samples: q.lut_samples.unwrap_or(d.lut_samples),
             lut_size: q.lut_size.unwrap_or(d.lut_size),
-            irradiance_source: q.irradiance_source.unwrap_or(d.irradiance_source),
+            irradiance_source: q.irradiance_source,
             lod_bias: q.lod_bias.unwrap_or(d.lod_bias),
             ..d
         };

@@ -232,19 +232,18 @@ impl Points {
 pub fn seed_settings(source_size: u32) -> Settings {
     Settings {
         size: source_size,
-        source_size,
-        mips: 6.min(splitsum_shaders::cubemap::CubeLayout::full_chain(source_size)),
-        mapping: RoughnessMapping::Linear,
+        source_size: Some(source_size),
+        mips: Some(6.min(splitsum_shaders::cubemap::CubeLayout::full_chain(source_size))),
+        mapping: Some(RoughnessMapping::Linear),
         samples: 1024,
         sample_growth: 1,
         exact_sums: false,
         lod_bias: 0.5,
         lut_method: TableMethod::Sampled,
-        lut_masking: Masking::SmithSchlick,
+        lut_masking: Some(Masking::SmithSchlick),
         lut_samples: 1024,
         ..Settings::default()
     }
-    .fitted()
 }
 
 /// Bakes each method on `backend`, times it and measures it at `points`.
@@ -258,7 +257,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
         let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
         let opts = method.options();
         let dominant = usize::from(opts.flags & ShadeOptions::DOMINANT_DIRECTION != 0);
-        let correlated = usize::from(method.settings.lut_masking == Masking::SmithCorrelated);
+        let correlated = usize::from(method.settings.lut_masking.unwrap_or(method.settings.lut_method.default_masking()) == Masking::SmithCorrelated);
         // Per point: (r, n·v, total error, (a), (b), (c)).
         let per_point: Vec<(f32, f32, f64, f64, f64, f64)> = points
             .shading

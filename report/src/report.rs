@@ -107,7 +107,7 @@ impl Sweep {
     pub fn methods(&self, native: u32) -> Vec<crate::accuracy::Method> {
         use crate::accuracy::{Method, seed_settings};
         let src = native.min(self.accuracy_source).max(4);
-        let default = Settings { size: src, source_size: src, ..Settings::default() }.fitted();
+        let default = Settings { size: src, source_size: Some(src), ..Settings::default() };
         let flags = ShadeOptions::DEFAULT.flags & !(ShadeOptions::IBL | ShadeOptions::DIRECT);
         let mut methods = Vec::new();
         // Each method's error against its bake time: the seed at three sample counts, the
@@ -137,7 +137,7 @@ impl Sweep {
             Method {
                 label: "defaults, Smith-Schlick table".into(),
                 family: "options",
-                settings: Settings { lut_masking: Masking::SmithSchlick, ..default },
+                settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default },
                 flags,
             },
         ]);
@@ -161,12 +161,12 @@ impl Sweep {
         let level = |label: &str, n: u32, lut: u32, irr: u32| {
             let s = Settings {
                 size: specular_size,
-                source_size,
-                mips,
+                source_size: Some(source_size),
+                mips: Some(mips),
                 samples: n,
                 irradiance_size: (specular_size / 2).max(4),
-                irradiance_source: irr.min(source_size),
-                sh_source: source_size,
+                irradiance_source: Some(irr.min(source_size)),
+                sh_source: Some(source_size),
                 lut_size: lut,
                 lut_samples: n,
                 ..Settings::default()
@@ -221,7 +221,7 @@ fn directions(n: u32) -> Vec<Vec3> {
 pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, dir: &Path) -> Result<Vec<Measurement>> {
     files::create_folder(dir)?;
     files::check_writable(&dir.join("report.md"))?;
-    let settings = Settings { source_size: sweep.source_size, size: sweep.source_size, ..Settings::default() };
+    let settings = Settings { source_size: Some(sweep.source_size), size: sweep.source_size, ..Settings::default() };
     let source = bake::host_source_cube(&Backend::Cpu, env, &settings)?;
     let texels = reference::texels(source.level(0), sweep.source_size);
     let refs = {
@@ -246,8 +246,8 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
     // The end-to-end measure: what a renderer shows.
     let native = env.native_face_size();
     let methods = sweep.methods(native);
-    let src = methods[0].settings.source_size;
-    let acc_source = bake::host_source_cube(&Backend::Cpu, env, &Settings { source_size: src, size: src, ..Settings::default() }.fitted())?;
+    let src = methods[0].settings.source_size.unwrap_or(methods[0].settings.size);
+    let acc_source = bake::host_source_cube(&Backend::Cpu, env, &Settings { source_size: Some(src), size: src, ..Settings::default() })?;
     let points = {
         let what =
             format!("report: end-to-end references (f64, {} shading points, {} lookups, {src}² source)", sweep.accuracy_points.0, sweep.accuracy_points.1);

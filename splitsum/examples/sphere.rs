@@ -191,7 +191,7 @@ fn main() -> splitsum::Result<()> {
     let compute = if args.iter().any(|a| a == "--cpu") { Compute::Cpu } else { Compute::Gpu };
     let (device, queue) = open_device();
     let env = splitsum::environment::embedded_default()?;
-    let settings = Settings { size: 64, source_size: 128, mips: Settings::default_mips(64), ..Settings::default() };
+    let settings = Settings { size: 64, source_size: Some(128), ..Settings::default() };
     let material = Material { albedo: [0.5, 0.25, 0.1], f0: [0.04; 3], roughness: 0.3 };
     let start = std::time::Instant::now();
     let picture = draw(&device, &queue, &env, &settings, compute, material, 256)?;

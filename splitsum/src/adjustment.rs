@@ -1,10 +1,11 @@
 //! What a bake did with its input and settings other than take them as given: an input
 //! reduced, upsampled or cleaned as it was read, a sample count capped. Nothing is changed
 //! silently: each is returned to the caller ([`crate::environment::InputReport::adjustments`],
-//! [`crate::settings::Settings::adjustments`]), which states it in its own terms
+//! [`crate::settings::Job::adjustments`]), which states it in its own terms
 //! ([`Adjustment::describe`]: the command line names its flags) and records it
 //! (`bake.json`'s `adjustments`).
 
+use crate::field::Field;
 use serde::Serialize;
 
 /// One change from what was given.
@@ -75,7 +76,7 @@ pub enum Adjustment {
 impl Adjustment {
     /// The adjustment in words, naming each setting through `term` (a field name of
     /// `Settings` → what the caller calls it: a flag, a scene field).
-    pub fn describe(&self, term: &dyn Fn(&'static str) -> String) -> String {
+    pub fn describe(&self, term: &dyn Fn(Field) -> String) -> String {
         match *self {
             Adjustment::Reduced { from, to, source_size } => format!(
                 "{}×{} read as {}×{} (area-weighted): a cube of {source_size}² faces resolves no more ({})",
@@ -83,31 +84,31 @@ impl Adjustment {
                 from.1,
                 to.0,
                 to.1,
-                term("source_size")
+                term(Field::SourceSize)
             ),
             Adjustment::FacesReduced { from, to } => {
-                format!("faces of {from}² read as {to}² (the cube's own mip filter): the bake uses no more ({})", term("source_size"))
+                format!("faces of {from}² read as {to}² (the cube's own mip filter): the bake uses no more ({})", term(Field::SourceSize))
             }
             Adjustment::Upsampled { width, height, resolves, source_size } => format!(
                 "{width}×{height} resolves about {resolves}² per cube face; the {source_size}² source cube ({}) interpolates it {}×, which adds time and no detail",
-                term("source_size"),
+                term(Field::SourceSize),
                 source_size / resolves.max(1)
             ),
             Adjustment::SamplesCapped { mip, asked, used } => format!(
                 "mip {mip} takes {used} GGX samples per texel, not the {asked} that {} × {}^{} asks for (the most a mip takes)",
-                term("samples"),
-                term("sample_growth"),
+                term(Field::Samples),
+                term(Field::SampleGrowth),
                 mip.saturating_sub(1)
             ),
             Adjustment::NegativeTexels { count } => format!("{count} texels had negative values, set to 0"),
             Adjustment::ClampedTexels { count, max } => format!("{count} texels were brighter than {max:e} and were clamped to it"),
-            Adjustment::Sanitized { nan, infinite } => format!("replaced {nan} NaN and {infinite} infinite texels ({})", term("sanitize")),
+            Adjustment::Sanitized { nan, infinite } => format!("replaced {nan} NaN and {infinite} infinite texels, as sanitising asks"),
         }
     }
 }
 
 impl std::fmt::Display for Adjustment {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.describe(&|field| format!("`{field}`")))
+        f.write_str(&self.describe(&|field| format!("`{}`", field.name())))
     }
 }

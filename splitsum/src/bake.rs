@@ -5,23 +5,22 @@
 //! and the CPU rasteriser. Everything else (plans, caches, the display) calls these.
 
 use crate::backend::{Backend, Kernels, Prefilter, with_kernels};
-use crate::cost::{self, Calibration, STEPS};
+use crate::cost::{self, Calibration};
 use crate::environment::Environment;
 use crate::error::{Error, Result};
-use crate::settings::{Products, Settings, TableMethod, exact_levels, level_of_size};
+use crate::settings::{InputShape, Job, Products, Settings, Step, TableMethod};
 use crate::texture::{Cube, Lut, Sh9};
 use serde::Serialize;
 use splitsum_shaders::cubemap::{self, CubeLayout};
-use splitsum_shaders::equirect;
 use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::shade::EnvironmentShape;
 use std::time::Instant;
 
-/// Wall time of one product.
+/// Wall time of one step.
 #[derive(Clone, Debug, Serialize)]
 pub struct Timing {
-    /// The product.
-    pub product: &'static str,
+    /// The step.
+    pub step: Step,
     /// Seconds.
     pub seconds: f64,
 }
@@ -30,9 +29,7 @@ pub struct Timing {
 pub struct Made<T> {
     /// The source cube with its full mip chain.
     pub source: T,
-    /// Its layout.
-    pub source_layout: CubeLayout,
-    /// The specular cube (`Settings::specular_layout`).
+    /// The specular cube (`Job::specular_layout`).
     pub specular: Option<T>,
     /// The irradiance cube (`E/π`).
     pub irradiance: Option<T>,
@@ -40,14 +37,15 @@ pub struct Made<T> {
     pub sh9: Option<Sh9>,
     /// The BRDF table, `(A, B, 0, 0)` per texel.
     pub lut: Option<T>,
-    /// Wall time of each product.
+    /// Wall time of each step.
     pub timings: Vec<Timing>,
 }
 
 /// The results of a bake, in host memory.
 pub struct Baked {
-    /// The source cube with its mips.
-    pub source: Cube,
+    /// The source cube with its mips (absent where the bake read textures back and
+    /// nothing kept it).
+    pub source: Option<Cube>,
     /// The specular cube.
     pub specular: Option<Cube>,
     /// The irradiance cube (`E/π`).
@@ -56,61 +54,50 @@ pub struct Baked {
     pub sh9: Option<Sh9>,
     /// The BRDF table.
     pub lut: Option<Lut>,
-    /// Wall time of each product.
+    /// Wall time of each step.
     pub timings: Vec<Timing>,
 }
 
-/// Runs step `product` on `k`, estimated at `estimates` (see [`step_estimates`]), with its
+/// Runs `step` on `k`, estimated at `estimates` (see [`step_estimates`]), with its
 /// progress shown, and records its wall time (until the backend has finished it).
-fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, product: &'static str, estimates: &[f64; 4], f: impl FnOnce() -> Result<T>) -> Result<T> {
-    let estimate = STEPS.iter().position(|s| *s == product).map(|k| estimates[k]);
-    let _step = crate::progress::step(product, estimate);
+fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, step: Step, estimates: &cost::Seconds, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    let _progress = crate::progress::step(step.name(), Some(estimates[step]));
     let start = Instant::now();
     let r = f()?;
     k.finish()?;
-    timings.push(Timing { product, seconds: start.elapsed().as_secs_f64() });
+    timings.push(Timing { step, seconds: start.elapsed().as_secs_f64() });
     Ok(r)
 }
 
-/// Estimated seconds of each of `cost::STEPS` when baking `products` (and `levels` of the
-/// specular cube) of `env` with `settings`, on the GPU (`gpu`) or the CPU (the built-in
+/// Estimated seconds of each step of `job`, on the GPU (`gpu`) or the CPU (the built-in
 /// calibration: lavapipe, 2 cores).
-pub fn step_estimates(gpu: bool, env: &Environment, settings: &Settings, products: Products, levels: &[u32]) -> [f64; 4] {
-    let width = match env {
-        Environment::Equirect(e) => e.width,
-        Environment::Cube(_) => 0,
-    };
-    cost::step_seconds(settings, products, levels, width, &Calibration::default(), gpu)
+pub fn step_estimates(gpu: bool, job: &Job) -> cost::Seconds {
+    cost::step_seconds(job, &Calibration::default(), gpu)
 }
 
 /// Runs estimated over this many seconds are refused unless forced.
 pub const MAX_UNFORCED_SECONDS: f64 = 3600.0;
 
-/// Refuses a run estimated (`estimates`, seconds per `cost::STEPS`) to take over an hour,
-/// unless `force` (`Error::TooLong`, naming the estimate and its longest step).
-pub fn check_duration(estimates: &[f64; 4], force: bool) -> Result<()> {
-    let total: f64 = estimates.iter().sum();
+/// Refuses a run estimated (`estimates`, seconds per step) to take over an hour, unless
+/// `force` (`Error::TooLong`, naming the estimate and its longest step).
+pub fn check_duration(estimates: &cost::Seconds, force: bool) -> Result<()> {
+    let total = estimates.total();
     if total <= MAX_UNFORCED_SECONDS || force {
         return Ok(());
     }
-    let (k, longest) = estimates.iter().copied().enumerate().max_by(|a, b| a.1.total_cmp(&b.1)).expect("four steps");
-    Err(Error::TooLong { seconds: total, step: STEPS[k], step_seconds: longest })
+    let step = estimates.longest();
+    Err(Error::TooLong { seconds: total, step, step_seconds: estimates[step] })
 }
 
-/// The source cube of `env` for `settings` with its full mip chain: resampled from an
-/// equirect, or the given faces reduced to `settings.source_size` through their mip chain.
-pub fn source_cube<K: Kernels>(k: &K, env: &Environment, settings: &Settings) -> Result<(K::Texels, CubeLayout)> {
-    let size = settings.source_size;
-    let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
+/// The source cube of `env` for `job` with its full mip chain: resampled from an
+/// equirect, or the given faces reduced to `job.source_size` through their mip chain.
+pub fn source_cube<K: Kernels>(k: &K, env: &Environment, job: &Job) -> Result<(K::Texels, CubeLayout)> {
     match env {
-        Environment::Equirect(e) => {
-            let n = equirect::supersampling(size, e.width, settings.supersample_density);
-            Ok((k.equirect_to_cube(e, size, n, settings.facing)?, layout))
-        }
+        Environment::Equirect(e) => Ok((k.equirect_to_cube(e, job.source_size, job.supersample, job.facing)?, job.source_layout())),
         Environment::Cube(c) => {
             let s = c.layout.size;
             let full_layout = CubeLayout::new(s, CubeLayout::full_chain(s));
-            let mut texels = if settings.target.fixed().mirror_faces {
+            let mut texels = if job.mirror_faces {
                 // The faces as the target's baker reads them: mirrored in x (a permutation).
                 (0..6 * s * s)
                     .map(|k| {
@@ -122,105 +109,91 @@ pub fn source_cube<K: Kernels>(k: &K, env: &Environment, settings: &Settings) ->
                 c.texels.clone()
             };
             texels.resize(full_layout.texel_count() as usize, Default::default());
-            cube_source(k, k.upload("cube faces", &texels)?, c.layout.size, settings)
+            cube_source(k, k.upload("cube faces", &texels)?, c.layout.size, job)
         }
     }
 }
 
-/// The source cube of `settings` from a cube whose faces are `face` wide: `full` holds its
+/// The source cube of `job` from a cube whose faces are `face` wide: `full` holds its
 /// level 0 in a buffer of its full mip chain; the chain is filtered and the levels from
-/// `settings.source_size` down are kept.
-pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, settings: &Settings) -> Result<(K::Texels, CubeLayout)> {
-    let size = settings.source_size;
+/// `job.source_size` down are kept.
+pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, job: &Job) -> Result<(K::Texels, CubeLayout)> {
+    let size = job.source_size;
     if face < size {
-        return Err(Error::setting("source_size", format!("{size} is larger than the cube's {face}×{face} faces; upsampling adds nothing")));
+        return Err(Error::setting(
+            crate::settings::Field::SourceSize,
+            format!("{size} is larger than the cube's {face}×{face} faces; upsampling adds nothing"),
+        ));
     }
     let full_layout = CubeLayout::new(face, CubeLayout::full_chain(face));
     k.build_mips(&mut full, full_layout)?;
-    let start = full_layout.level_offset(level_of_size(full_layout, size));
-    Ok((k.slice(&full, start, full_layout.texel_count() - start)?, CubeLayout::new(size, CubeLayout::full_chain(size))))
+    let start = full_layout.level_offset(crate::settings::level_of_size(full_layout, size));
+    Ok((k.slice(&full, start, full_layout.texel_count() - start)?, job.source_layout()))
 }
 
-/// Bakes `products` (and `levels` of the specular cube; the others stay zero) from a
-/// source cube already on backend `k`.
-pub fn products<K: Kernels>(
-    k: &K,
-    source: K::Texels,
-    source_layout: CubeLayout,
-    settings: &Settings,
-    products: Products,
-    levels: &[u32],
-    estimates: &[f64; 4],
-    mut timings: Vec<Timing>,
-) -> Result<Made<K::Texels>> {
-    let s = settings;
-    let specular = if products.specular {
-        let (roughness, samples) = (s.roughness(), s.samples_per_mip());
-        let exact = exact_levels(&roughness, &samples, s.exact_sums, source_layout);
-        let job = Prefilter { layout: s.specular_layout(), roughness: &roughness, levels, samples: &samples, exact: &exact, lod_bias: s.lod_bias };
-        Some(timed(k, &mut timings, "specular", estimates, || k.prefilter(&source, source_layout, &job))?)
+/// Bakes the products of `job` from a source cube already on backend `k`.
+pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout, job: &Job, estimates: &cost::Seconds, mut timings: Vec<Timing>) -> Result<Made<K::Texels>> {
+    let p = job.products;
+    let specular = if p.specular {
+        let pf = Prefilter {
+            layout: job.specular_layout(),
+            roughness: &job.roughness_per_mip,
+            levels: &job.levels,
+            samples: &job.samples_per_mip,
+            exact: &job.exact_levels,
+            lod_bias: job.lod_bias,
+        };
+        Some(timed(k, &mut timings, Step::Specular, estimates, || k.prefilter(&source, source_layout, &pf))?)
     } else {
         None
     };
-    let irradiance = if products.irradiance {
-        let level = level_of_size(source_layout, s.irradiance_source);
-        Some(timed(k, &mut timings, "irradiance", estimates, || k.irradiance(&source, source_layout, level, s.irradiance_size))?)
+    let irradiance = if p.irradiance {
+        Some(timed(k, &mut timings, Step::Irradiance, estimates, || k.irradiance(&source, source_layout, job.irradiance_level(), job.irradiance_size))?)
     } else {
         None
     };
-    let sh9 = if products.sh9 {
-        let level = level_of_size(source_layout, s.sh_source);
-        Some(timed(k, &mut timings, "sh9", estimates, || k.sh9(&source, source_layout, level))?)
-    } else {
-        None
-    };
-    let lut = if products.lut {
-        Some(timed(k, &mut timings, "brdf lut", estimates, || match s.lut_method {
-            TableMethod::Quadrature => k.brdf_table(s.lut_size, s.lut_masking),
-            TableMethod::Sampled => k.brdf_lut(s.lut_size, s.lut_samples),
+    let sh9 = if p.sh9 { Some(timed(k, &mut timings, Step::Sh9, estimates, || k.sh9(&source, source_layout, job.sh_level()))?) } else { None };
+    let lut = if p.lut {
+        Some(timed(k, &mut timings, Step::BrdfTable, estimates, || match job.lut_method {
+            TableMethod::Quadrature => k.brdf_table(job.lut_size, job.lut_masking),
+            TableMethod::Sampled => k.brdf_lut(job.lut_size, job.lut_samples),
         })?)
     } else {
         None
     };
-    Ok(Made { source, source_layout, specular, irradiance, sh9, lut, timings })
+    Ok(Made { source, specular, irradiance, sh9, lut, timings })
 }
 
-/// Validates `settings`, then bakes `products` (and `levels` of the specular cube) of
-/// `env` on backend `k`, leaving them there.
-pub fn make<K: Kernels>(k: &K, gpu: bool, env: &Environment, settings: &Settings, products: Products, levels: &[u32]) -> Result<Made<K::Texels>> {
-    settings.validate()?;
-    if let Some(&m) = levels.iter().find(|&&m| m >= settings.mips) {
-        return Err(Error::setting("mips", format!("has no mip {m} to bake (there are {})", settings.mips)));
-    }
-    let est = step_estimates(gpu, env, settings, products, levels);
+/// Bakes `job` from `env` on backend `k`, leaving the products there.
+pub fn make<K: Kernels>(k: &K, gpu: bool, env: &Environment, job: &Job) -> Result<Made<K::Texels>> {
+    let est = step_estimates(gpu, job);
     let mut timings = Vec::new();
-    let (source, layout) = timed(k, &mut timings, "source cube", &est, || source_cube(k, env, settings))?;
-    self::products(k, source, layout, settings, products, levels, &est, timings)
+    let (source, layout) = timed(k, &mut timings, Step::SourceCube, &est, || source_cube(k, env, job))?;
+    self::products(k, source, layout, job, &est, timings)
 }
 
 /// `made` read into host memory.
-pub fn read<K: Kernels>(k: &K, made: Made<K::Texels>, settings: &Settings) -> Result<Baked> {
+pub fn read<K: Kernels>(k: &K, made: Made<K::Texels>, job: &Job) -> Result<Baked> {
     let cube = |layout: CubeLayout, t: &K::Texels| -> Result<Cube> { Ok(Cube { layout, texels: k.read(t)? }) };
     Ok(Baked {
-        source: cube(made.source_layout, &made.source)?,
-        specular: made.specular.as_ref().map(|t| cube(settings.specular_layout(), t)).transpose()?,
-        irradiance: made.irradiance.as_ref().map(|t| cube(CubeLayout::new(settings.irradiance_size, 1), t)).transpose()?,
+        source: Some(cube(job.source_layout(), &made.source)?),
+        specular: made.specular.as_ref().map(|t| cube(job.specular_layout(), t)).transpose()?,
+        irradiance: made.irradiance.as_ref().map(|t| cube(job.irradiance_layout(), t)).transpose()?,
         sh9: made.sh9,
-        lut: made.lut.as_ref().map(|t| -> Result<Lut> { Ok(Lut::from_texels(settings.lut_size, &k.read(t)?)) }).transpose()?,
+        lut: made.lut.as_ref().map(|t| -> Result<Lut> { Ok(Lut::from_texels(job.lut_size, &k.read(t)?)) }).transpose()?,
         timings: made.timings,
     })
 }
 
-/// Bakes `products` of `env` with `settings` on `backend`, every specular mip, into host
-/// memory.
+/// Bakes `products` of `env` with `settings` on `backend`, into host memory.
 pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products: Products) -> Result<Baked> {
-    bake_levels(backend, env, settings, products, &settings.all_levels())
+    bake_job(backend, env, &settings.resolve(InputShape::of(env), products)?)
 }
 
-/// As [`bake`], baking only `levels` of the specular cube (the others stay zero).
-pub fn bake_levels(backend: &Backend, env: &Environment, settings: &Settings, products: Products, levels: &[u32]) -> Result<Baked> {
+/// Bakes `job` (resolved for `env`) on `backend`, into host memory.
+pub fn bake_job(backend: &Backend, env: &Environment, job: &Job) -> Result<Baked> {
     let gpu = backend.is_gpu();
-    with_kernels!(backend, k => read(k, make(k, gpu, env, settings, products, levels)?, settings))
+    with_kernels!(backend, k => read(k, make(k, gpu, env, job)?, job))
 }
 
 /// A 1×1 cube of zeros: the stand-in for a product a plan leaves out (nothing reads it).
@@ -232,7 +205,7 @@ impl Baked {
     /// What a renderer reads, with stand-ins for the products not baked (nothing reads
     /// them) and the source cube's level 0 (the sharp sky).
     pub fn into_display(self, mapping: RoughnessMapping) -> BakedEnvironment {
-        let source = self.source.levels(0, 0);
+        let source = self.source.as_ref().map_or_else(empty_cube, |s| s.levels(0, 0));
         BakedEnvironment {
             source,
             specular: self.specular.unwrap_or_else(empty_cube),
@@ -294,14 +267,16 @@ impl BakedEnvironment {
 
 /// Bakes what a renderer reads ([`Products::DISPLAY`]) of `env` on `backend`.
 pub fn bake_for_display(backend: &Backend, env: &Environment, settings: &Settings) -> Result<BakedEnvironment> {
-    Ok(bake(backend, env, settings, Products::DISPLAY)?.into_display(settings.mapping))
+    let job = settings.resolve(InputShape::of(env), Products::DISPLAY)?;
+    Ok(bake_job(backend, env, &job)?.into_display(job.mapping))
 }
 
 /// The source cube of `env` for `settings` (with its full mip chain) on `backend`, in
 /// host memory.
 pub fn host_source_cube(backend: &Backend, env: &Environment, settings: &Settings) -> Result<Cube> {
+    let job = settings.resolve(InputShape::of(env), Products::DISPLAY)?;
     with_kernels!(backend, k => {
-        let (t, layout) = source_cube(k, env, settings)?;
+        let (t, layout) = source_cube(k, env, &job)?;
         Ok(Cube { layout, texels: k.read(&t)? })
     })
 }

@@ -1,10 +1,9 @@
 //! What a bake costs before it runs: the error model and cost rates a plan chooses from
-//! ([`Calibration`]), and the time and memory of given settings ([`estimate`],
+//! ([`Calibration`]), and the time and memory of a resolved bake ([`estimate`],
 //! [`step_seconds`]).
 
-use crate::settings::{Products, Settings, TableMethod};
+use crate::settings::{InputShape, Job, Settings, Step, TableMethod};
 use serde::Serialize;
-use splitsum_shaders::cubemap::CubeLayout;
 
 /// Error of each product against its reference, per setting, and the cost rates of each
 /// backend: what the planner chooses from. The built-in one is `runner report` on the two
@@ -22,9 +21,19 @@ pub struct Calibration {
     pub prefilter: Vec<(f32, Vec<(u32, f64)>)>,
     /// Irradiance convolution: (source face size, mean relative error).
     pub irradiance: Vec<(u32, f64)>,
-    /// Nanoseconds per unit of work on (lavapipe, CPU): equirect supersample, prefilter
-    /// sample, BRDF table sample, irradiance texel pair.
-    pub ns: [(f64, f64); 4],
+    /// Nanoseconds per unit of work on (lavapipe, CPU), per step (see `work`).
+    pub ns: Rates,
+}
+
+/// Nanoseconds per unit of work of each step on (lavapipe, CPU).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Rates(pub [(f64, f64); 5]);
+
+impl std::ops::Index<Step> for Rates {
+    type Output = (f64, f64);
+    fn index(&self, s: Step) -> &(f64, f64) {
+        &self.0[Step::ALL.iter().position(|x| *x == s).expect("every step is listed")]
+    }
 }
 
 impl Default for Calibration {
@@ -46,8 +55,9 @@ impl Default for Calibration {
             irradiance: vec![(4, 0.035), (8, 0.0181), (16, 0.0067), (32, 0.00168), (64, 0.00083)],
             // Rates from `runner bench` of the defaults on city.exr: 12.2 M prefilter samples in
             // 0.51 s / 0.82 s, 36 M table evaluations (quadrature) in 0.12 s / 0.33 s, 9.4 M
-            // irradiance texel pairs in 0.077 s / 0.156 s.
-            ns: [(139.0, 46.0), (41.5, 67.0), (3.3, 9.1), (8.2, 16.5)],
+            // irradiance texel pairs in 0.077 s / 0.156 s. An SH9 texel (nine basis
+            // functions, one weighted add each) is taken at an irradiance pair's rate.
+            ns: Rates([(139.0, 46.0), (41.5, 67.0), (8.2, 16.5), (8.2, 16.5), (3.3, 9.1)]),
         }
     }
 }
@@ -153,67 +163,103 @@ impl Cost {
     }
 }
 
-/// The steps of a bake the cost model knows, in the order they run, with the index of
-/// their rate in [`Calibration::ns`].
-pub const STEPS: [&str; 4] = ["source cube", "specular", "brdf lut", "irradiance"];
+/// A number per step of a bake (seconds, units of work), indexed by [`Step`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct PerStep(pub [f64; 5]);
 
-/// Units of work of each of [`STEPS`] (equirect supersamples, prefilter samples, BRDF
-/// table evaluations, irradiance texel pairs) and the bytes of the products in memory.
-fn work(s: &Settings, products: Products, levels: &[u32], width: u32) -> ([f64; 4], u64) {
-    let mut work = [0.0f64; 4];
+/// Seconds of each step.
+pub type Seconds = PerStep;
+
+impl std::ops::Index<Step> for PerStep {
+    type Output = f64;
+    fn index(&self, s: Step) -> &f64 {
+        &self.0[Step::ALL.iter().position(|x| *x == s).expect("every step is listed")]
+    }
+}
+
+impl std::ops::IndexMut<Step> for PerStep {
+    fn index_mut(&mut self, s: Step) -> &mut f64 {
+        &mut self.0[Step::ALL.iter().position(|x| *x == s).expect("every step is listed")]
+    }
+}
+
+impl PerStep {
+    /// The sum over the steps.
+    pub fn total(&self) -> f64 {
+        self.0.iter().sum()
+    }
+
+    /// The step with the largest value.
+    pub fn longest(&self) -> Step {
+        Step::ALL.into_iter().max_by(|a, b| self[*a].total_cmp(&self[*b])).expect("five steps")
+    }
+}
+
+/// Units of work of each step (equirect supersamples, prefilter samples or an eighth of
+/// an exact sum's terms, irradiance texel pairs, SH9 texels, BRDF table evaluations) of
+/// `job`, and the bytes of its products in memory.
+fn work(job: &Job) -> (PerStep, u64) {
+    let mut work = PerStep::default();
     let mut bytes = 0u64;
-    let n = splitsum_shaders::equirect::supersampling(s.source_size, width.max(1), s.supersample_density) as f64;
-    let source = CubeLayout::new(s.source_size, CubeLayout::full_chain(s.source_size));
-    work[0] = 6.0 * (s.source_size as f64).powi(2) * n * n;
+    let source = job.source_layout();
+    if let InputShape::Equirect { .. } | InputShape::Unknown = job.input {
+        work[Step::SourceCube] = 6.0 * (job.source_size as f64).powi(2) * (job.supersample as f64).powi(2);
+    }
     bytes += source.texel_count() as u64 * 16;
-    if products.specular {
-        let out = s.specular_layout();
-        let samples = s.samples_per_mip();
-        for &l in levels {
+    if job.products.specular {
+        let out = job.specular_layout();
+        for &l in &job.levels {
             let texels = 6.0 * (out.level_size(l) as f64).powi(2);
-            let r = s.mapping.roughness(l, s.mips);
+            let r = job.roughness_per_mip[l as usize];
             if r > 0.0 {
-                let n = samples[l as usize];
                 // An exact sum's 6t² terms cost about an eighth of a sample each.
-                let per_texel = if s.exact_sums && splitsum_shaders::prefilter::prefers_exact(r, n, s.source_size) {
-                    6.0 * (splitsum_shaders::prefilter::exact_source_size(r, s.source_size) as f64).powi(2) / 8.0
+                let per_texel = if job.exact_levels[l as usize] != splitsum_shaders::prefilter::SAMPLED {
+                    6.0 * (source.level_size(job.exact_levels[l as usize]) as f64).powi(2) / 8.0
                 } else {
-                    n as f64
+                    job.samples_per_mip[l as usize] as f64
                 };
-                work[1] += texels * per_texel;
+                work[Step::Specular] += texels * per_texel;
             }
             // The sums (3 × RGBA per texel) and the result.
             bytes += texels as u64 * 64;
         }
     }
-    if products.lut {
-        let per_texel = match s.lut_method {
+    if job.products.lut {
+        let per_texel = match job.lut_method {
             TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
-            TableMethod::Sampled => s.lut_samples,
+            TableMethod::Sampled => job.lut_samples,
         };
-        work[2] = (s.lut_size as f64).powi(2) * per_texel as f64;
-        bytes += (s.lut_size as u64).pow(2) * 24;
+        work[Step::BrdfTable] = (job.lut_size as f64).powi(2) * per_texel as f64;
+        bytes += (job.lut_size as u64).pow(2) * 24;
     }
-    if products.irradiance {
-        work[3] = 6.0 * (s.irradiance_size as f64).powi(2) * 6.0 * (s.irradiance_source as f64).powi(2);
-        bytes += 6 * (s.irradiance_size as u64).pow(2) * 64;
+    if job.products.irradiance {
+        work[Step::Irradiance] = 6.0 * (job.irradiance_size as f64).powi(2) * 6.0 * (job.irradiance_source as f64).powi(2);
+        bytes += 6 * (job.irradiance_size as u64).pow(2) * 64;
+    }
+    if job.products.sh9 {
+        work[Step::Sh9] = 6.0 * (job.sh_source as f64).powi(2);
     }
     (work, bytes)
 }
 
-/// Estimated seconds of each of [`STEPS`] that `products` run, on lavapipe (`gpu`) or on
-/// 2 CPU cores.
-pub fn step_seconds(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration, gpu: bool) -> [f64; 4] {
-    let (work, _) = work(s, products, levels, width);
-    std::array::from_fn(|k| work[k] * if gpu { cal.ns[k].0 } else { cal.ns[k].1 } * 1e-9)
+/// Estimated seconds of each step of `job`, on lavapipe (`gpu`) or on 2 CPU cores.
+pub fn step_seconds(job: &Job, cal: &Calibration, gpu: bool) -> Seconds {
+    let (work, _) = work(job);
+    let mut out = PerStep::default();
+    for s in Step::ALL {
+        let (g, c) = cal.ns[s];
+        out[s] = work[s] * if gpu { g } else { c } * 1e-9;
+    }
+    out
 }
 
-/// Estimated time and memory of baking `products` (and `levels` of the specular cube)
-/// from an equirect `width` wide: the products and their sums, plus the environment as
-/// read (RGBA f32, with its row pyramid: `12·width²` bytes).
-pub fn estimate(s: &Settings, products: Products, levels: &[u32], width: u32, cal: &Calibration) -> Cost {
-    let (_, bytes) = work(s, products, levels, width);
-    let gpu = step_seconds(s, products, levels, width, cal, true).iter().sum();
-    let cpu = step_seconds(s, products, levels, width, cal, false).iter().sum();
-    Cost { gpu_seconds: gpu, cpu_seconds: cpu, bytes: bytes + 12 * (width as u64).pow(2) }
+/// Estimated time and memory of `job`: the products and their sums, plus the environment
+/// as read (RGBA f32, with its row pyramid: `12·width²` bytes).
+pub fn estimate(job: &Job, cal: &Calibration) -> Cost {
+    let (_, bytes) = work(job);
+    let width = match job.input {
+        InputShape::Equirect { width, .. } => width as u64,
+        _ => 0,
+    };
+    Cost { gpu_seconds: step_seconds(job, cal, true).total(), cpu_seconds: step_seconds(job, cal, false).total(), bytes: bytes + 12 * width.pow(2) }
 }

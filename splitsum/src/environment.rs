@@ -12,6 +12,7 @@
 use crate::adjustment::Adjustment;
 use crate::error::{Error, Result};
 use crate::texture::{Cube, Equirect};
+use serde::Serialize;
 use splitsum_shaders::cubemap::{self, CubeLayout};
 use splitsum_shaders::equirect;
 use splitsum_shaders::glam::Vec4;
@@ -51,6 +52,36 @@ impl Environment {
     }
 }
 
+/// What an environment is, as far as a bake's plan goes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum InputShape {
+    /// An equirect image (as read: after any reduction).
+    Equirect {
+        /// Width.
+        width: u32,
+        /// Height.
+        height: u32,
+    },
+    /// A cube of six faces.
+    Cube {
+        /// Face size.
+        size: u32,
+    },
+    /// Not known (settings checked on their own).
+    Unknown,
+}
+
+impl InputShape {
+    /// The shape of `env`.
+    pub fn of(env: &Environment) -> Self {
+        match env {
+            Environment::Equirect(e) => InputShape::Equirect { width: e.width, height: e.height },
+            Environment::Cube(c) => InputShape::Cube { size: c.layout.size },
+        }
+    }
+}
+
 /// What was found and changed while reading.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct InputReport {
@@ -76,11 +107,16 @@ impl InputReport {
     /// What reading changed, with `env` as read: a reduction, negative texels set to 0,
     /// texels clamped, NaN and ∞ replaced.
     pub fn adjustments(&self, env: &Environment) -> Vec<Adjustment> {
+        self.adjustments_for(InputShape::of(env))
+    }
+
+    /// [`InputReport::adjustments`] of an environment of `shape` as read.
+    pub fn adjustments_for(&self, shape: InputShape) -> Vec<Adjustment> {
         let mut out = Vec::new();
         let (w, h) = self.original;
-        match env {
-            Environment::Equirect(e) if e.width < w => out.push(Adjustment::Reduced { from: (w, h), to: (e.width, e.height), source_size: self.read_for }),
-            Environment::Cube(c) if c.layout.size < w => out.push(Adjustment::FacesReduced { from: w, to: c.layout.size }),
+        match shape {
+            InputShape::Equirect { width, height } if width < w => out.push(Adjustment::Reduced { from: (w, h), to: (width, height), source_size: self.read_for }),
+            InputShape::Cube { size } if size < w => out.push(Adjustment::FacesReduced { from: w, to: size }),
             _ => {}
         }
         if self.negative > 0 {

@@ -46,7 +46,7 @@ pub enum Error {
     #[error("{field} {problem}")]
     Setting {
         /// The field of `Settings`.
-        field: &'static str,
+        field: crate::field::Field,
         /// What is wrong with its value.
         problem: String,
     },
@@ -55,8 +55,8 @@ pub enum Error {
     TooLong {
         /// The estimate, in seconds.
         seconds: f64,
-        /// Its longest step (one of `cost::STEPS`).
-        step: &'static str,
+        /// Its longest step.
+        step: crate::field::Step,
         /// That step's estimate.
         step_seconds: f64,
     },
@@ -72,7 +72,7 @@ impl Error {
     }
 
     /// A problem with field `field` of `Settings`.
-    pub fn setting(field: &'static str, problem: impl Into<String>) -> Self {
+    pub fn setting(field: crate::field::Field, problem: impl Into<String>) -> Self {
         Self::Setting { field, problem: problem.into() }
     }
 }

@@ -4,6 +4,7 @@
 //! `bake.json` (what was baked, how, from what, and how long it took).
 
 use crate::bake::{Baked, Timing};
+use crate::adjustment::Adjustment;
 use crate::environment::InputReport;
 use crate::error::Result;
 use crate::files;
@@ -11,7 +12,7 @@ use crate::ktx1;
 use crate::ktx2;
 use crate::ktx2::Supercompression;
 use crate::preview;
-use crate::settings::{Settings, Target};
+use crate::settings::{Job, Target};
 use crate::texture::{Cube, Sh9};
 use serde::Serialize;
 use splitsum_shaders::choice::Choice;
@@ -32,6 +33,17 @@ pub struct OutputFile {
     pub written: Option<ktx2::Written>,
 }
 
+/// Where a bake came from, for its `bake.json`: the caller says (`Default` for none).
+#[derive(Clone, Debug, Default)]
+pub struct About {
+    /// The environment, as the caller names it.
+    pub environment: String,
+    /// The backend it was baked on.
+    pub backend: String,
+    /// What reading the environment found, if it was read from a file.
+    pub input: Option<InputReport>,
+}
+
 /// `bake.json`: what was baked, how, from what, and how long it took.
 #[derive(Clone, Debug, Serialize)]
 pub struct Manifest {
@@ -39,8 +51,8 @@ pub struct Manifest {
     pub environment: String,
     /// The backend.
     pub backend: String,
-    /// Every setting.
-    pub settings: Settings,
+    /// Every setting, resolved: the values the bake used.
+    pub settings: Job,
     /// Roughness of each specular mip.
     pub roughness_per_mip: Vec<f32>,
     /// GGX samples per texel of each specular mip (mip 0, the mirror, is copied).
@@ -48,10 +60,11 @@ pub struct Manifest {
     /// What the default settings measure end to end (`runner report`), for reference.
     pub accuracy: &'static str,
     /// What reading the environment found.
-    pub input: InputSummary,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input: Option<InputSummary>,
     /// What the bake changed from what it was given (an input reduced or upsampled, a
     /// sample count capped, texels cleaned), each also stated when it ran.
-    pub adjustments: Vec<crate::adjustment::Adjustment>,
+    pub adjustments: Vec<Adjustment>,
     /// Wall time per product.
     pub timings: Vec<Timing>,
     /// How far SH9 irradiance is from the convolution, over the irradiance cube's texels.
@@ -135,44 +148,72 @@ struct ShFile<'a> {
     irradiance_over_pi: [[f64; 3]; 9],
 }
 
-/// Writes every baked product into `dir` (created if missing) in the files of
-/// `settings.target`, each file atomically, and `bake.json` last. `name` names the bake
-/// where a target's file names carry it (Filament's `NAME_ibl.ktx`): the output folder's
-/// name, as cmgen's `--deploy` folder.
-pub fn write(dir: &Path, name: &str, baked: &Baked, settings: &Settings, manifest_base: Manifest) -> Result<Manifest> {
+/// Writes the baked products of `job` as the folder `out` (replaced as a unit, and only
+/// if everything in it is what splitsum wrote there: `files::OutputDir`), in the files of
+/// `job.target`, with `bake.json`. The folder's name names the bake where a target's file
+/// names carry it (Filament's `NAME_ibl.ktx`), as cmgen's `--deploy` folder; `called` is
+/// what the caller calls `out`, for messages.
+pub fn write(out: &Path, called: &str, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
+    let folder = files::OutputDir::begin(out, called)?;
+    let name = out.file_name().map_or_else(|| "ibl".into(), |n| n.to_string_lossy().into_owned());
+    let manifest = write_into(folder.path(), &name, baked, job, about)?;
+    folder.commit()?;
+    Ok(manifest)
+}
+
+/// [`write()`] into the folder `dir` as it is (created if missing), each file atomically and
+/// `bake.json` last.
+pub fn write_into(dir: &Path, name: &str, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
     let _step = crate::progress::step("writing the files", None);
     files::create_folder(dir)?;
-    let mut manifest = manifest_base;
-    if settings.target != Target::Splitsum {
-        manifest.files = engine_files(dir, name, baked, settings)?;
-        manifest.conventions = target_conventions(settings.target).to_vec();
-        manifest.timings = baked.timings.clone();
+    let mut manifest = Manifest {
+        environment: about.environment,
+        backend: about.backend,
+        settings: job.clone(),
+        roughness_per_mip: job.roughness_per_mip.clone(),
+        samples_per_mip: job.samples_per_mip.clone(),
+        accuracy: DEFAULTS_ACCURACY,
+        input: about.input.as_ref().map(InputSummary::from),
+        adjustments: Vec::new(),
+        timings: baked.timings.clone(),
+        sh9_vs_convolution: None,
+        files: Vec::new(),
+        conventions: target_conventions(job.target).to_vec(),
+    };
+    manifest.adjustments = about.input.as_ref().map_or_else(Vec::new, |input| input.adjustments_for(job.input));
+    manifest.adjustments.extend(job.adjustments());
+    if job.target != Target::Splitsum {
+        manifest.files = engine_files(dir, name, baked, job)?;
         return write_manifest(dir, manifest);
     }
     let mut files_out = Vec::new();
     let mut add = |name: &str, what: String, written: Option<ktx2::Written>| {
         files_out.push(OutputFile { name: name.to_string(), what, written });
     };
-    let exposure = preview::auto_exposure(baked.source.level(0));
+    // Previews at the source's exposure (the specular cube's mip 0 where no source was kept).
+    let sky = baked.source.as_ref().or(baked.specular.as_ref());
+    let exposure = sky.map_or(1.0, |c| preview::auto_exposure(c.level(0)));
     let save_png = |name: &str, pic: &preview::Picture| -> Result<()> {
         files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
     };
-    save_png("preview_source.png", &preview::cross(&baked.source, 0, settings.source_size.min(256)))?;
-    add("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None);
+    if let Some(source) = &baked.source {
+        save_png("preview_source.png", &preview::cross(source, 0, job.source_size.min(256)))?;
+        add("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None);
+    }
     if let Some(spec) = &baked.specular {
-        let w = ktx2::write(&dir.join("specular.ktx2"), spec, settings.format)?;
+        let w = ktx2::write(&dir.join("specular.ktx2"), spec, job.format)?;
         report_clamp("specular.ktx2", &w);
         add("specular.ktx2", "GGX-prefiltered radiance, one roughness per mip (roughness_per_mip)".into(), Some(w));
         for m in 0..spec.layout.levels {
             let name = format!("specular_mip{m}.exr");
-            files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", settings.roughness()[m as usize]))?;
+            files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip[m as usize]))?;
             add(&name, format!("mip {m} as EXR for inspection"), None);
         }
         save_png("preview_specular.png", &preview::mip_strip(spec, 64))?;
         add("preview_specular.png", "every specular mip as a cross, roughness rising to the right".into(), None);
     }
     if let Some(irr) = &baked.irradiance {
-        let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, settings.format)?;
+        let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, job.format)?;
         report_clamp("irradiance.ktx2", &w);
         add("irradiance.ktx2", "irradiance divided by π (cosine-weighted mean radiance)".into(), Some(w));
         files::write_cube_level_exr(&dir.join("irradiance.exr"), irr, 0, "irradiance / pi")?;
@@ -198,7 +239,6 @@ pub fn write(dir: &Path, name: &str, baked: &Baked, settings: &Settings, manifes
         add("brdf_lut.png", "its 8-bit preview".into(), None);
     }
     manifest.files = files_out;
-    manifest.timings = baked.timings.clone();
     if let (Some(sh), Some(irr)) = (&baked.sh9, &baked.irradiance) {
         manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
     }
@@ -225,16 +265,16 @@ fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
 /// - `filament`: `NAME_ibl.ktx` (specular mips, KTX 1.1 `R11F_G11F_B10F`, SH in its `sh`
 ///   metadata), `NAME_skybox.ktx` (the source cube's level 0) and `sh.txt`: cmgen
 ///   `--format=ktx --deploy`.
-pub fn engine_files(dir: &Path, name: &str, baked: &Baked, settings: &Settings) -> Result<Vec<OutputFile>> {
+pub fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> Result<Vec<OutputFile>> {
     let mut out = Vec::new();
     let mut add = |name: String, what: &str, written: Option<ktx2::Written>| {
         out.push(OutputFile { name, what: what.into(), written });
     };
-    let missing = |what: &str| crate::error::Error::Invalid(format!("the {} target needs the {what}, which was not baked", settings.target.name()));
-    match settings.target {
+    let missing = |what: &str| crate::error::Error::Invalid(format!("the {} target needs the {what}, which was not baked", job.target.name()));
+    match job.target {
         Target::Splitsum => unreachable!("the splitsum folder is written by output::write"),
         Target::Khronos | Target::Bevy => {
-            let khronos = settings.target == Target::Khronos;
+            let khronos = job.target == Target::Khronos;
             let (spec_name, diffuse_name, sc) = if khronos {
                 ("ggx/specular.ktx2", "lambertian/diffuse.ktx2", Supercompression::None)
             } else {
@@ -245,11 +285,11 @@ pub fn engine_files(dir: &Path, name: &str, baked: &Baked, settings: &Settings) 
                 files::create_folder(&dir.join("lambertian"))?;
             }
             let spec = baked.specular.as_ref().ok_or_else(|| missing("specular cube"))?;
-            let w = ktx2::write_with(&dir.join(spec_name), spec, settings.format, sc)?;
+            let w = ktx2::write_with(&dir.join(spec_name), spec, job.format, sc)?;
             report_clamp(spec_name, &w);
             add(spec_name.into(), "GGX-prefiltered radiance, mip m at perceptual roughness m/(mips-1)", Some(w));
             let irr = baked.irradiance.as_ref().ok_or_else(|| missing("irradiance cube"))?;
-            let w = ktx2::write_with(&dir.join(diffuse_name), irr, settings.format, sc)?;
+            let w = ktx2::write_with(&dir.join(diffuse_name), irr, job.format, sc)?;
             report_clamp(diffuse_name, &w);
             add(diffuse_name.into(), "irradiance divided by pi (Lambertian-filtered radiance)", Some(w));
             let lut = baked.lut.as_ref().ok_or_else(|| missing("BRDF table"))?;
@@ -281,7 +321,7 @@ pub fn engine_files(dir: &Path, name: &str, baked: &Baked, settings: &Settings) 
                 "GGX-prefiltered radiance (KTX 1.1, R11F_G11F_B10F), mip m at perceptual roughness 1 - sqrt(1 - m/(mips-1)); 'sh' metadata: E/pi SH for the shader",
                 Some(w),
             );
-            let sky = baked.source.levels(0, 0);
+            let sky = baked.source.as_ref().ok_or_else(|| missing("source cube (the skybox)"))?.levels(0, 0);
             let skybox = format!("{name}_skybox.ktx");
             let w = ktx1::write(&dir.join(&skybox), &sky, &[])?;
             report_clamp(&skybox, &w);

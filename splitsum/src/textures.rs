@@ -17,8 +17,8 @@ use crate::backend::{Cpu, Gpu, Kernels, gpu, gpu::Texels};
 use crate::bake::{self, Baked, Made, Timing};
 use crate::environment::Environment;
 use crate::error::{Error, Result};
-use crate::settings::{Products, Settings};
-use crate::texture::{Cube, Equirect};
+use crate::settings::{InputShape, Job, Products, Settings, Step};
+use crate::texture::{Cube, Equirect, Lut};
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_shaders::glam::Vec4;
@@ -67,16 +67,6 @@ pub struct Ibl {
     pub timings: Vec<Timing>,
 }
 
-/// The products read back from an [`Ibl`]'s textures, as f32.
-pub struct IblData {
-    /// The specular cube.
-    pub specular: Cube,
-    /// The irradiance cube.
-    pub irradiance: Cube,
-    /// The BRDF table, `(A, B, 0, 0)` per texel.
-    pub brdf: Vec<Vec4>,
-}
-
 /// Bakes on the caller's device.
 pub struct Baker {
     device: wgpu::Device,
@@ -109,24 +99,29 @@ impl Baker {
     /// Bakes the specular cube, the irradiance cube and the BRDF table of `source` with
     /// `settings` (validated first) into textures on the baker's device.
     pub fn bake(&self, source: Source<'_>, settings: &Settings) -> Result<Ibl> {
-        settings.validate()?;
-        let levels = settings.all_levels();
-        let products = Products::DISPLAY;
+        let shape = match source {
+            Source::Environment(env) => InputShape::of(env),
+            Source::Texture(t) => match texture_shape(t)? {
+                Shape::Equirect => InputShape::Equirect { width: t.width(), height: t.height() },
+                Shape::Cube => InputShape::Cube { size: t.width() },
+            },
+        };
+        let job = settings.resolve(shape, Products::DISPLAY)?;
         match &self.gpu {
             Some(g) => {
                 let made = match source {
-                    Source::Environment(env) => bake::make(g, true, env, settings, products, &levels)?,
+                    Source::Environment(env) => bake::make(g, true, env, &job)?,
                     Source::Texture(t) => {
-                        let est = [0.0; 4];
+                        let est = bake::step_estimates(true, &job);
                         let mut timings = Vec::new();
                         let start = std::time::Instant::now();
-                        let (src, layout) = texture_source_cube(g, t, settings)?;
+                        let (src, layout) = texture_source_cube(g, t, &job)?;
                         g.finish()?;
-                        timings.push(Timing { product: "source cube", seconds: start.elapsed().as_secs_f64() });
-                        bake::products(g, src, layout, settings, products, &levels, &est, timings)?
+                        timings.push(Timing { step: Step::SourceCube, seconds: start.elapsed().as_secs_f64() });
+                        bake::products(g, src, layout, &job, &est, timings)?
                     }
                 };
-                self.gpu_textures(g, made, settings)
+                self.gpu_textures(g, made, &job)
             }
             None => {
                 let owned;
@@ -137,15 +132,15 @@ impl Baker {
                         &owned
                     }
                 };
-                let made = bake::make(&Cpu, false, env, settings, products, &levels)?;
-                let baked = bake::read(&Cpu, made, settings)?;
-                Ok(self.upload(&baked, settings))
+                let made = bake::make(&Cpu, false, env, &job)?;
+                let baked = bake::read(&Cpu, made, &job)?;
+                Ok(self.upload(&baked, &job))
             }
         }
     }
 
-    /// The textures of `settings`' products, empty.
-    fn textures(&self, settings: &Settings) -> (wgpu::Texture, wgpu::Texture, wgpu::Texture) {
+    /// The textures of `job`'s products, empty.
+    fn textures(&self, job: &Job) -> (wgpu::Texture, wgpu::Texture, wgpu::Texture) {
         let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
         let cube = |label, size, mips| {
             self.device.create_texture(&wgpu::TextureDescriptor {
@@ -159,7 +154,7 @@ impl Baker {
                 view_formats: &[],
             })
         };
-        let lut = settings.lut_size;
+        let lut = job.lut_size;
         let brdf = self.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("splitsum brdf table"),
             size: wgpu::Extent3d { width: lut, height: lut, depth_or_array_layers: 1 },
@@ -170,25 +165,25 @@ impl Baker {
             usage,
             view_formats: &[],
         });
-        (cube("splitsum specular", settings.size, settings.mips), cube("splitsum irradiance", settings.irradiance_size, 1), brdf)
+        (cube("splitsum specular", job.size, job.mips), cube("splitsum irradiance", job.irradiance_size, 1), brdf)
     }
 
-    fn ibl(&self, settings: &Settings, textures: (wgpu::Texture, wgpu::Texture, wgpu::Texture), timings: Vec<Timing>) -> Ibl {
+    fn ibl(&self, job: &Job, textures: (wgpu::Texture, wgpu::Texture, wgpu::Texture), timings: Vec<Timing>) -> Ibl {
         let (specular, irradiance, brdf) = textures;
-        Ibl { specular, irradiance, brdf, roughness: settings.roughness(), mapping: settings.mapping, timings }
+        Ibl { specular, irradiance, brdf, roughness: job.roughness_per_mip.clone(), mapping: job.mapping, timings }
     }
 
     /// Packs the products on the device and copies them into the textures.
-    fn gpu_textures(&self, g: &Gpu, made: Made<Texels>, settings: &Settings) -> Result<Ibl> {
-        let textures = self.textures(settings);
+    fn gpu_textures(&self, g: &Gpu, made: Made<Texels>, job: &Job) -> Result<Ibl> {
+        let textures = self.textures(job);
         let missing = || Error::Invalid("a display bake made no product".into());
         let spec = made.specular.as_ref().ok_or_else(missing)?;
         let irr = made.irradiance.as_ref().ok_or_else(missing)?;
         let lut = made.lut.as_ref().ok_or_else(missing)?;
-        self.gpu_copy(g, spec, settings.specular_layout(), FACES, 4, &textures.0)?;
-        self.gpu_copy(g, irr, CubeLayout::new(settings.irradiance_size, 1), FACES, 4, &textures.1)?;
-        self.gpu_copy(g, lut, CubeLayout::new(settings.lut_size, 1), 1, 2, &textures.2)?;
-        Ok(self.ibl(settings, textures, made.timings))
+        self.gpu_copy(g, spec, job.specular_layout(), FACES, 4, &textures.0)?;
+        self.gpu_copy(g, irr, job.irradiance_layout(), FACES, 4, &textures.1)?;
+        self.gpu_copy(g, lut, CubeLayout::new(job.lut_size, 1), 1, 2, &textures.2)?;
+        Ok(self.ibl(job, textures, made.timings))
     }
 
     /// Packs every level of `texels` (laid out as `layout` with `layers` layers) into
@@ -236,8 +231,8 @@ impl Baker {
 
     /// Packs host products into halves (the same function the kernel runs) and writes
     /// them into new textures.
-    fn upload(&self, baked: &Baked, settings: &Settings) -> Ibl {
-        let textures = self.textures(settings);
+    fn upload(&self, baked: &Baked, job: &Job) -> Ibl {
+        let textures = self.textures(job);
         let write = |texture: &wgpu::Texture, texels: &[Vec4], layout: CubeLayout, layers: u32, channels: u32| {
             for m in 0..layout.levels {
                 let s = layout.level_size(m);
@@ -260,7 +255,7 @@ impl Baker {
         write(&textures.1, &irr.texels, irr.layout, FACES, 4);
         let table: Vec<Vec4> = lut.texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect();
         write(&textures.2, &table, CubeLayout::new(lut.size, 1), 1, 2);
-        self.ibl(settings, textures, baked.timings.clone())
+        self.ibl(job, textures, baked.timings.clone())
     }
 
     /// Copies mip 0 of `texture` (every layer) into a buffer of 256-byte-aligned rows:
@@ -367,8 +362,8 @@ fn read_cube(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture
     Ok(bytemuck::cast_slice(&gpu::map_read(device, &staging)?).to_vec())
 }
 
-/// The source cube of `settings` from a texture on the device, without leaving it.
-fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) -> Result<(Texels, CubeLayout)> {
+/// The source cube of `job` from a texture on the device, without leaving it.
+fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, job: &Job) -> Result<(Texels, CubeLayout)> {
     let shape = texture_shape(texture)?;
     if matches!(shape, Shape::Cube) && !gpu::copies_cubes(&g.device) {
         let size = texture.size().width;
@@ -377,7 +372,7 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) ->
         let mut encoder = g.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum source cube") });
         gpu::CubeReader::new(&g.device, texture.format()).record(&g.device, &mut encoder, texture, CubeLayout::new(size, 1), &texels.buffer);
         g.queue.submit([encoder.finish()]);
-        return cube_from_texture(g, texels, size, settings);
+        return cube_from_texture(g, texels, size, job);
     }
     let baker = Baker { device: g.device.clone(), queue: g.queue.clone(), gpu: None };
     let (words, row, half) = baker.copy_out(texture, wgpu::BufferUsages::STORAGE)?;
@@ -397,28 +392,21 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, settings: &Settings) ->
         invocations: [size.width, rows, 1],
     }]);
     match shape {
-        Shape::Equirect => {
-            let source_size = settings.source_size;
-            let n = splitsum_shaders::equirect::supersampling(source_size, size.width, settings.supersample_density);
-            Ok((
-                g.pyramid_to_cube(&texels.buffer, size.width, size.height, source_size, n, settings.facing)?,
-                CubeLayout::new(source_size, CubeLayout::full_chain(source_size)),
-            ))
-        }
-        Shape::Cube => cube_from_texture(g, texels, size.width, settings),
+        Shape::Equirect => Ok((g.pyramid_to_cube(&texels.buffer, size.width, size.height, job.source_size, job.supersample, job.facing)?, job.source_layout())),
+        Shape::Cube => cube_from_texture(g, texels, size.width, job),
     }
 }
 
-/// The source cube of `settings` from a cube texture's level 0, read into `texels` (its
-/// full mip chain long), faces `face` wide.
-fn cube_from_texture(g: &Gpu, texels: Texels, face: u32, settings: &Settings) -> Result<(Texels, CubeLayout)> {
-    if settings.target.fixed().mirror_faces {
+/// The source cube of `job` from a cube texture's level 0, read into `texels` (its full
+/// mip chain long), faces `face` wide.
+fn cube_from_texture(g: &Gpu, texels: Texels, face: u32, job: &Job) -> Result<(Texels, CubeLayout)> {
+    if job.mirror_faces {
         return Err(Error::setting(
-            "target",
-            format!("{}: a cube texture is not mirrored on the device; pass its faces as host data (Source::Environment) or an equirect", settings.target.name()),
+            crate::settings::Field::Target,
+            format!("{}: a cube texture is not mirrored on the device; pass its faces as host data (Source::Environment) or an equirect", job.target.name()),
         ));
     }
-    bake::cube_source(g, texels, face, settings)
+    bake::cube_source(g, texels, face, job)
 }
 
 impl Ibl {
@@ -427,8 +415,10 @@ impl Ibl {
         self.mapping.lod(roughness, self.roughness.len() as u32)
     }
 
-    /// Reads the textures back (decoding the halves): for tests, inspection and files.
-    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<IblData> {
+    /// Reads the textures back (decoding the halves) into host memory, as [`Baked`]
+    /// products (the specular and irradiance cubes and the table; no source cube or SH9):
+    /// for files (`output::write`), tests and inspection.
+    pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Baked> {
         let read = |t: &wgpu::Texture, channels: u32| -> Result<Vec<Vec4>> {
             let mut out = Vec::new();
             let layers = t.size().depth_or_array_layers;
@@ -469,6 +459,15 @@ impl Ibl {
             let texels = if gpu::copies_cubes(device) { read(t, 4)? } else { read_cube(device, queue, t, layout)? };
             Ok(Cube { layout, texels })
         };
-        Ok(IblData { specular: cube(&self.specular)?, irradiance: cube(&self.irradiance)?, brdf: read(&self.brdf, 2)? })
+        let size = self.brdf.size().width;
+        let brdf = Lut { size, texels: read(&self.brdf, 2)?.into_iter().map(|v| v.truncate().truncate()).collect() };
+        Ok(Baked {
+            source: None,
+            specular: Some(cube(&self.specular)?),
+            irradiance: Some(cube(&self.irradiance)?),
+            sh9: None,
+            lut: Some(brdf),
+            timings: self.timings.clone(),
+        })
     }
 }

@@ -90,12 +90,12 @@ pub fn source_cube(name: &str, size: u32) -> splitsum::texture::Cube {
 pub fn small_display_bake() -> splitsum::bake::BakedEnvironment {
     let settings = splitsum::settings::Settings {
         size: 32,
-        source_size: 64,
-        mips: 4,
+        source_size: Some(64),
+        mips: Some(4),
         samples: 64,
         irradiance_size: 8,
-        irradiance_source: 16,
-        sh_source: 16,
+        irradiance_source: Some(16),
+        sh_source: Some(16),
         lut_size: 32,
         lut_samples: 64,
         ..splitsum::settings::Settings::default()

@@ -1,6 +1,7 @@
 //! `runner bake`: an environment, or a scene's plan, into an output folder.
 
 use super::*;
+use crate::settings::InputShape;
 use crate::{bake, output};
 
 #[derive(Args)]
@@ -40,39 +41,27 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     }
     let env_path = args.env.clone().expect("clap requires ENV without --scene");
     let settings = args.quality.settings();
-    settings.validate()?;
-    refuse_unread(given, &settings, settings.target.products(), env_path.is_dir())?;
-    let out = files::OutputDir::begin(&args.out, "--out")?;
-    let (env, input) = load_input(&env_path, args.sanitize, settings.source_size)?;
-    let backend = Backend::open(args.backend)?;
     // An engine target bakes only what its engine reads.
     let products = settings.target.products();
-    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, products, &settings.all_levels()), args.scene.force)?;
-    println!("baking {} on {} for {}", env_path.display(), backend.describe(), settings.target.name());
-    let changed = settings.adjustments(&env);
-    for a in &changed {
+    // The flags are checked before anything is read or written.
+    let source_size = settings.resolve(InputShape::Unknown, products)?.source_size;
+    refuse_unread(given, &settings, products, env_path.is_dir())?;
+    let out = files::OutputDir::begin(&args.out, "--out")?;
+    let (env, input) = load_input(&env_path, args.sanitize, source_size)?;
+    let job = settings.resolve(InputShape::of(&env), products)?;
+    let backend = Backend::open(args.backend)?;
+    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.scene.force)?;
+    println!("baking {} on {} for {}", env_path.display(), backend.describe(), job.target.name());
+    for a in job.adjustments() {
         eprintln!("note: {}", a.describe(&flag_of));
     }
-    let baked = bake::bake(&backend, &env, &settings, products)?;
-    let manifest = output::Manifest {
-        environment: env_path.display().to_string(),
-        backend: backend.describe(),
-        settings: settings.clone(),
-        roughness_per_mip: settings.roughness(),
-        samples_per_mip: settings.samples_per_mip(),
-        accuracy: output::DEFAULTS_ACCURACY,
-        input: (&input).into(),
-        adjustments: input.adjustments(&env).into_iter().chain(changed).collect(),
-        timings: Vec::new(),
-        sh9_vs_convolution: None,
-        files: Vec::new(),
-        conventions: output::CONVENTIONS.to_vec(),
-    };
+    let baked = bake::bake_job(&backend, &env, &job)?;
+    let about = output::About { environment: env_path.display().to_string(), backend: backend.describe(), input: Some(input) };
     let name = out.target().file_name().map_or_else(|| "ibl".into(), |n| n.to_string_lossy().into_owned());
-    let manifest = output::write(out.path(), &name, &baked, &settings, manifest)?;
+    let manifest = output::write_into(out.path(), &name, &baked, &job, about)?;
     out.commit()?;
     for t in &manifest.timings {
-        println!("  {:<12} {:>9.3} s", t.product, t.seconds);
+        println!("  {:<12} {:>9.3} s", t.step.name(), t.seconds);
     }
     println!("  {:<12} {:>9.3} s", "total", manifest.timings.iter().map(|t| t.seconds).sum::<f64>());
     if let Some(e) = manifest.sh9_vs_convolution {
@@ -93,19 +82,19 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
 fn write_scene_bake(out: &files::OutputDir, sb: &crate::prepare::SceneBake, format: &Format) -> anyhow::Result<()> {
     let dir = out.path();
     let p = &sb.plan;
+    let job = &p.job;
     let mut written = Vec::new();
-    let all_roughness = p.settings.roughness();
     let mut specular_roughness = Vec::new();
-    if let (true, Some(&first), Some(&last)) = (p.products.specular, p.levels.first(), p.levels.last()) {
+    if let (true, Some(&first), Some(&last)) = (job.products.specular, job.levels.first(), job.levels.last()) {
         crate::ktx2::write(&dir.join("specular.ktx2"), &sb.env.specular.levels(first, last), *format)?;
-        specular_roughness = (first..=last).map(|l| if p.levels.contains(&l) { Some(all_roughness[l as usize]) } else { None }).collect();
+        specular_roughness = (first..=last).map(|l| if job.levels.contains(&l) { Some(job.roughness_per_mip[l as usize]) } else { None }).collect();
         written.push("specular.ktx2");
     }
-    if p.products.irradiance {
+    if job.products.irradiance {
         crate::ktx2::write(&dir.join("irradiance.ktx2"), &sb.env.irradiance, *format)?;
         written.push("irradiance.ktx2");
     }
-    if p.products.lut {
+    if job.products.lut {
         files::write_lut_exr(&dir.join("brdf_lut.exr"), &sb.env.lut)?;
         written.push("brdf_lut.exr");
     }

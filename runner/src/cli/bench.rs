@@ -2,6 +2,7 @@
 
 use super::*;
 use crate::bake;
+use crate::settings::InputShape;
 
 #[derive(Args)]
 pub(super) struct BenchArgs {
@@ -22,19 +23,20 @@ pub(super) struct BenchArgs {
 
 pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let settings = args.quality.settings();
-    settings.validate()?;
-    let (env, _) = load_input(&args.env, false, settings.source_size)?;
+    let source_size = settings.resolve(InputShape::Unknown, Products::ALL)?.source_size;
+    let (env, _) = load_input(&args.env, false, source_size)?;
+    let job = settings.resolve(InputShape::of(&env), Products::ALL)?;
     println!(
         "bench: {} at size {}, {} mips ({:?}), {:?} samples per mip, irradiance {}² from {}², SH9 from {}², table {}",
         args.env.display(),
-        settings.size,
-        settings.mips,
-        settings.mapping,
-        settings.samples_per_mip(),
-        settings.irradiance_size,
-        settings.irradiance_source,
-        settings.sh_source,
-        settings.table_description()
+        job.size,
+        job.mips,
+        job.mapping,
+        job.samples_per_mip,
+        job.irradiance_size,
+        job.irradiance_source,
+        job.sh_source,
+        job.table_description()
     );
     for kind in &args.backends {
         let backend = match Backend::open(*kind) {
@@ -44,10 +46,10 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 continue;
             }
         };
-        bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::ALL, &settings.all_levels()), args.force)?;
+        bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.force)?;
         let mut best: Vec<bake::Timing> = Vec::new();
         for _ in 0..args.runs.max(1) {
-            let baked = bake::bake(&backend, &env, &settings, Products::ALL)?;
+            let baked = bake::bake_job(&backend, &env, &job)?;
             if best.is_empty() {
                 best = baked.timings;
             } else {
@@ -58,7 +60,7 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
         }
         println!("{}", backend.describe());
         for t in &best {
-            println!("  {:<12} {:>9.3} s", t.product, t.seconds);
+            println!("  {:<12} {:>9.3} s", t.step.name(), t.seconds);
         }
         println!("  {:<12} {:>9.3} s", "total", best.iter().map(|t| t.seconds).sum::<f64>());
     }

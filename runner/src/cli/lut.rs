@@ -1,6 +1,7 @@
 //! `runner lut`: the split-sum BRDF table alone.
 
 use super::*;
+use crate::settings::Step;
 
 #[derive(Args)]
 pub(super) struct LutArgs {
@@ -40,27 +41,32 @@ pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
     if let Some(p) = &png {
         files::check_output_file(p, files::FileKind::Png, "--png (the preview beside --out)")?;
     }
+    // The table's flags, named as this command names them.
+    let lut_flag = |f: Field| match f {
+        Field::LutSize => "--size".to_string(),
+        Field::LutSamples => "--samples".to_string(),
+        Field::LutMethod => "--method".to_string(),
+        Field::LutMasking => "--masking".to_string(),
+        f => flag_of(f),
+    };
+    let in_flags = |e| in_flags(e, &lut_flag);
+    let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: args.masking, ..Settings::default() };
+    let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };
+    let job = settings.resolve(crate::settings::InputShape::Unknown, only_table).map_err(in_flags)?;
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();
-    let masking = args.masking.unwrap_or(args.method.default_masking());
-    let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: masking, ..Settings::default() };
-    if settings.lut_method == TableMethod::Sampled && settings.lut_masking != Masking::SmithSchlick {
-        return Err(Usage::new("--masking correlated needs --method quadrature (the sampled table is Smith–Schlick only)").into());
-    }
-    // The table is the cost model's third step (`plan::STEPS[2]`); a table needs no source cube.
-    let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };
-    let table = crate::cost::step_seconds(&settings, only_table, &[], 0, &crate::cost::Calibration::default(), backend.is_gpu())[2];
-    let flags = [("lut_size", "--size"), ("lut_samples", "--samples"), ("lut_method", "--method"), ("lut_masking", "--masking")];
-    let in_flags = |e| in_flags(e, &flags, &["", "", "--size and --samples", ""]);
-    crate::bake::check_duration(&[0.0, 0.0, table, 0.0], args.force).map_err(in_flags)?;
-    let lut = match settings.lut_method {
-        TableMethod::Quadrature => backend.brdf_table(settings.lut_size, settings.lut_masking),
-        TableMethod::Sampled => backend.brdf_lut(settings.lut_size, settings.lut_samples),
+    // A table alone needs no source cube: its own step's estimate is the run's.
+    let mut table = crate::cost::PerStep::default();
+    table[Step::BrdfTable] = crate::bake::step_estimates(backend.is_gpu(), &job)[Step::BrdfTable];
+    crate::bake::check_duration(&table, args.force).map_err(in_flags)?;
+    let lut = match job.lut_method {
+        TableMethod::Quadrature => backend.brdf_table(job.lut_size, job.lut_masking),
+        TableMethod::Sampled => backend.brdf_lut(job.lut_size, job.lut_samples),
     }
     .map_err(in_flags)?;
     let secs = start.elapsed().as_secs_f64();
     files::write_lut_exr(&args.out, &lut).context("writing the BRDF table")?;
-    println!("brdf lut {} on {}: bake {:.3} s", settings.table_description(), backend.describe(), secs);
+    println!("brdf lut {} on {}: bake {:.3} s", job.table_description(), backend.describe(), secs);
     println!("wrote {}", args.out.display());
     if let Some(p) = png {
         files::write_png(&p, lut.size, lut.size, &files::lut_preview(&lut))?;

@@ -13,7 +13,7 @@ mod view;
 use crate::environment;
 use crate::files;
 use crate::ktx2::Format;
-use crate::settings::{Products, Settings, TableMethod, Target};
+use crate::settings::{Field, Products, Settings, TableMethod, Target};
 use crate::{Backend, BackendKind};
 use anyhow::Context;
 use clap::{Args, Parser, Subcommand};
@@ -203,7 +203,7 @@ impl DisplayBakeArgs {
     /// Bake settings for the display of `env`: the source cube as sharp as the environment
     /// (a quarter of an equirect's width, up to 1024), the rest from the flags.
     pub fn settings(&self, env: &environment::Environment) -> Settings {
-        Settings { size: self.size, mips: Settings::default_mips(self.size), samples: self.samples, ..Settings::display(env.native_face_size()) }
+        Settings { size: self.size, samples: self.samples, ..Settings::display(env.native_face_size()) }
     }
 }
 
@@ -278,35 +278,29 @@ pub struct QualityArgs {
 }
 
 impl QualityArgs {
-    /// The bake settings these flags describe.
+    /// The bake settings these flags describe (what a flag leaves out, the library derives
+    /// from the others and the target; a flag that contradicts the target is refused by
+    /// `Settings::resolve`, by its name).
     pub fn settings(&self) -> Settings {
-        // What the target fixes fills the flags not given; a given flag that differs is
-        // refused by Settings::validate, by its name.
-        let fixed = self.target.fixed();
-        let mips = self.mips.or(fixed.mips.map(|m| m(self.size))).unwrap_or_else(|| Settings::default_mips(self.size));
-        let source_size = self.source_size.unwrap_or(self.size);
-        let d = Settings::default();
         Settings {
+            target: self.target,
             size: self.size,
-            source_size,
-            mips,
-            mapping: self.mapping.or(fixed.mapping).unwrap_or(d.mapping),
+            source_size: self.source_size,
+            mips: self.mips,
+            mapping: self.mapping,
             samples: self.samples,
             sample_growth: self.sample_growth,
             exact_sums: !self.sampled_only,
             lod_bias: self.lod_bias,
             supersample_density: self.supersample,
             irradiance_size: self.irradiance_size,
-            // Defaults that exceed a small source are fitted to it; given values are checked.
-            irradiance_source: self.irradiance_source.unwrap_or(d.irradiance_source.min(source_size)),
-            sh_source: self.sh_source.unwrap_or(d.sh_source.min(source_size)),
+            irradiance_source: self.irradiance_source,
+            sh_source: self.sh_source,
             lut_size: self.lut_size,
             lut_samples: self.lut_samples,
             lut_method: self.lut_method,
-            lut_masking: self.lut_masking.or(fixed.lut_masking).unwrap_or(self.lut_method.default_masking()),
+            lut_masking: self.lut_masking,
             format: self.format,
-            facing: fixed.facing,
-            target: self.target,
         }
     }
 }
@@ -355,32 +349,35 @@ impl ShadingFlags {
     }
 }
 
-/// The flag of each `Settings` field, for errors in the user's own terms.
-const SETTING_FLAGS: [(&str, &str); 19] = [
-    ("target", "--target"),
-    ("facing", "--target"),
-    ("size", "--size"),
-    ("source_size", "--source-size"),
-    ("mips", "--mips"),
-    ("mapping", "--mapping"),
-    ("samples", "--samples"),
-    ("sample_growth", "--sample-growth"),
-    ("exact_sums", "--sampled-only"),
-    ("lod_bias", "--lod-bias"),
-    ("supersample_density", "--supersample"),
-    ("irradiance_size", "--irradiance-size"),
-    ("irradiance_source", "--irradiance-source"),
-    ("sh_source", "--sh-source"),
-    ("lut_size", "--lut-size"),
-    ("lut_samples", "--lut-samples"),
-    ("lut_method", "--lut-method"),
-    ("lut_masking", "--lut-masking"),
-    ("format", "--format"),
-];
+/// The flag that sets `field` (bake, bench and the display's quality flags), for messages
+/// in the user's own terms.
+pub(crate) fn flag(field: Field) -> &'static str {
+    match field {
+        Field::Target => "--target",
+        Field::Size => "--size",
+        Field::SourceSize => "--source-size",
+        Field::Mips => "--mips",
+        Field::Mapping => "--mapping",
+        Field::Samples => "--samples",
+        Field::SampleGrowth => "--sample-growth",
+        Field::ExactSums => "--sampled-only",
+        Field::LodBias => "--lod-bias",
+        Field::SupersampleDensity => "--supersample",
+        Field::IrradianceSize => "--irradiance-size",
+        Field::IrradianceSource => "--irradiance-source",
+        Field::ShSource => "--sh-source",
+        Field::LutSize => "--lut-size",
+        Field::LutSamples => "--lut-samples",
+        Field::LutMethod => "--lut-method",
+        Field::LutMasking => "--lut-masking",
+        Field::Format => "--format",
+    }
+}
 
-/// The flags that set the cost of each of `cost::STEPS`, for a refused long bake.
-const STEP_FLAGS: [&str; 4] =
-    ["--source-size and --supersample", "--samples, --sample-growth and --size", "--lut-size and --lut-samples", "--irradiance-size and --irradiance-source"];
+/// [`flag`] as an owned string, as `Adjustment::describe` and `Unread::describe` take it.
+pub(crate) fn flag_of(field: Field) -> String {
+    flag(field).to_string()
+}
 
 /// A request refused as written: a flag, its value, flags that contradict each other, the
 /// target or the scene, a scene file's fields, an output path that may not be replaced, a
@@ -416,18 +413,15 @@ pub fn exit_code(e: &anyhow::Error) -> i32 {
     }
 }
 
-/// A library error in the user's terms: a setting by the flag that sets it (`flags`: field
-/// to flag, beside [`SETTING_FLAGS`]), a refused long bake with the flags that set its cost
-/// and `--force`, unreadable texels with `--sanitize`.
-pub(crate) fn in_flags(e: splitsum::Error, flags: &[(&str, &str)], step_flags: &[&str; 4]) -> anyhow::Error {
+/// A library error in the user's terms: a setting by the flag `flag` names for it, a refused
+/// long bake with the flags that set its cost and `--force`, unreadable texels with
+/// `--sanitize`.
+pub(crate) fn in_flags(e: splitsum::Error, flag: &dyn Fn(Field) -> String) -> anyhow::Error {
     match e {
-        splitsum::Error::Setting { field, problem } => {
-            let flag = flags.iter().chain(SETTING_FLAGS.iter()).find(|(f, _)| *f == field).map_or(field, |(_, flag)| flag);
-            Usage::new(format!("{flag} {problem}")).into()
-        }
+        splitsum::Error::Setting { field, problem } => Usage::new(format!("{} {problem}", flag(field))).into(),
         splitsum::Error::TooLong { step, .. } => {
-            let k = crate::cost::STEPS.iter().position(|s| *s == step).unwrap_or(0);
-            Usage::new(format!("{e}; lower {} (scene: [quality]), or pass --force to run it anyway", step_flags[k])).into()
+            let flags: Vec<String> = step.cost_fields().iter().map(|f| flag(*f)).collect();
+            Usage::new(format!("{e}; lower {} (scene: [quality]), or pass --force to run it anyway", flags.join(" and "))).into()
         }
         splitsum::Error::Invalid(m) => Usage::new(m).into(),
         splitsum::Error::NonFinite { .. } => anyhow::anyhow!("{e}: pass --sanitize to do so"),
@@ -448,14 +442,9 @@ fn refuse_unread(given: &[String], settings: &Settings, products: Products, cube
     Ok(())
 }
 
-/// The flag that sets field `field` of `Settings` (or `--FIELD`), for messages.
-pub(crate) fn flag_of(field: &'static str) -> String {
-    SETTING_FLAGS.iter().find(|(f, _)| *f == field).map_or_else(|| format!("--{}", field.replace('_', "-")), |(_, flag)| flag.to_string())
-}
-
 /// [`in_flags`] for a bake's flags.
 pub(crate) fn bake_error(e: splitsum::Error) -> anyhow::Error {
-    in_flags(e, &[], &STEP_FLAGS)
+    in_flags(e, &flag_of)
 }
 
 /// With `--scene`, the scene file sets everything but where and how to run: refuses any

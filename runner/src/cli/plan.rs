@@ -16,7 +16,7 @@ pub(super) fn plan_command(args: PlanArgs) -> anyhow::Result<()> {
     let cal = SceneArgs { scene: None, force: false, cache: None, calibration: args.calibration.clone() }.calibration()?;
     let env_path = scene.environment.as_ref().map(|p| scene.resolve(p));
     let (env, name) = load_environment(env_path.as_deref(), scene.sanitize)?;
-    let plan = crate::plan::plan_for(&scene, &env, &cal);
+    let plan = crate::plan::plan_for(&scene, &env, &cal)?;
     print!("{}", crate::plan::describe(&plan, &args.scene.display().to_string(), &name));
     Ok(())
 }

@@ -55,13 +55,13 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
     let model = args.look.load_model()?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(args.backend)?;
-    let settings = args.bake.settings(&env);
-    for a in settings.adjustments(&env) {
+    let job = args.bake.settings(&env).resolve(crate::settings::InputShape::of(&env), Products::DISPLAY)?;
+    for a in job.adjustments() {
         eprintln!("note: {}", a.describe(&flag_of));
     }
-    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &env, &settings, Products::DISPLAY, &settings.all_levels()), args.scene.force)?;
+    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.scene.force)?;
     let start = Instant::now();
-    let baked = bake::bake_for_display(&backend, &env, &settings)?;
+    let baked = bake::bake_job(&backend, &env, &job)?.into_display(job.mapping);
     let bake_secs = start.elapsed().as_secs_f64();
     let view = args.look.view(baked.auto_exposure());
     let start = Instant::now();
