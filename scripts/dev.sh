@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # splitsum's one entry point for people and CI. It installs what the project needs on a
-# fresh machine (stable Rust, and Mesa's lavapipe Vulkan driver so the GPU backend runs
-# without a GPU), then runs:
+# fresh machine (stable Rust, and Mesa's lavapipe Vulkan and llvmpipe GL drivers so the GPU
+# backend runs without a GPU), then runs:
 #
 #   bash scripts/dev.sh run [ARGS...]   # the runner (no ARGS: the default bake and view)
-#   bash scripts/dev.sh test            # every test, optimised (the CPU path is slow in debug)
+#   bash scripts/dev.sh test            # every test, optimised (the CPU path is slow in debug),
+#                                       # then the GPU tests again on GL
 #   bash scripts/dev.sh cargo ARGS...   # any cargo command, on stable
 #   bash scripts/dev.sh spirv [--check] # regenerate spirv/src from shaders/ (or check it is
 #                                       # current): rust-gpu, on the nightly it pins
@@ -60,6 +61,11 @@ ensure_vulkan() {
     ensure_packages '/usr/share/vulkan/icd.d/lvp_icd*.json:mesa-vulkan-drivers' '/usr/lib/*/libvulkan.so.1:libvulkan1'
 }
 
+# Mesa's llvmpipe behind EGL runs the GPU tests a second time on wgpu's GL backend.
+ensure_gl() {
+    ensure_packages '/usr/lib/*/libEGL.so.1:libegl1' '/usr/lib/*/libEGL_mesa.so.0:libegl-mesa0' '/usr/lib/*/libGLESv2.so.2:libgles2' '/usr/lib/*/dri/swrast_dri.so:libgl1-mesa-dri'
+}
+
 # The windowed smoke test opens the viewer on Xvfb and screenshots it with xwd.
 ensure_test_display() {
     ensure_packages '/usr/bin/Xvfb:xvfb' '/usr/bin/xwd:x11-apps'
@@ -105,9 +111,17 @@ case "$cmd" in
     test)
         ensure_stable
         ensure_vulkan
+        ensure_gl
         ensure_test_display
         ensure_peers
-        exec cargo +stable test --release --workspace "$@"
+        cargo +stable test --release --workspace "$@"
+        # The GPU tests again on GL (llvmpipe, headless through EGL): every kernel, the
+        # textures on the caller's device, the engine targets and the renderer, held to
+        # the same GPU-vs-CPU bounds as on Vulkan.
+        echo "dev.sh: the GPU tests on GL (WGPU_BACKEND=gl)" >&2
+        WGPU_BACKEND=gl cargo +stable test --release -p splitsum-tests \
+            --test prefilter --test lut --test equirect --test irradiance --test stability \
+            --test library --test render --test targets "$@"
         ;;
     peers)
         ensure_peers

@@ -334,10 +334,24 @@ impl GpuScene {
             .create_view(&Default::default())
     }
 
-    /// Renders `frame` offscreen into an RGBA32F texture and reads it back (row 0 at the top).
+    /// The format frames are rendered into offscreen: RGBA32F where the device renders to
+    /// it, else RGBA16F (wgpu's GL backend on Mesa's llvmpipe renders to no 32-bit float
+    /// format): linear radiance above 65504 then reads as the largest half, and below it to
+    /// 11 bits.
+    pub fn offscreen_format(gpu: &Gpu) -> wgpu::TextureFormat {
+        let renders = |f: wgpu::TextureFormat| match &gpu.adapter {
+            Some(a) => a.get_texture_format_features(f).allowed_usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT),
+            None => f.guaranteed_format_features(gpu.device.features()).allowed_usages.contains(wgpu::TextureUsages::RENDER_ATTACHMENT),
+        };
+        if renders(wgpu::TextureFormat::Rgba32Float) { wgpu::TextureFormat::Rgba32Float } else { wgpu::TextureFormat::Rgba16Float }
+    }
+
+    /// Renders `frame` offscreen (in [`GpuScene::offscreen_format`]) and reads it back as
+    /// f32 (row 0 at the top).
     pub fn render_offscreen(&self, gpu: &Gpu, frame: &Frame, model: Option<&GpuModel>) -> Result<Vec<Vec4>> {
         let (w, h) = (frame.width as u32, frame.height as u32);
-        let format = wgpu::TextureFormat::Rgba32Float;
+        let format = Self::offscreen_format(gpu);
+        let texel = format.block_copy_size(None).expect("a colour format") as u64;
         let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("offscreen"),
             size: wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
@@ -352,7 +366,7 @@ impl GpuScene {
         let depth = Self::depth_texture(gpu, w, h);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         self.draw(gpu, &mut encoder, &view, &depth, format, frame, model);
-        let row = (w as u64 * 16).div_ceil(256) * 256;
+        let row = (w as u64 * texel).div_ceil(256) * 256;
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("offscreen readback"),
             size: row * h as u64,
@@ -371,8 +385,18 @@ impl GpuScene {
         let bytes = gpu.read_bytes(&buffer)?;
         let mut out = Vec::with_capacity((w * h) as usize);
         for y in 0..h as usize {
-            let start = y * row as usize;
-            out.extend(bytemuck::pod_collect_to_vec::<u8, Vec4>(&bytes[start..start + w as usize * 16]));
+            let line = &bytes[y * row as usize..y * row as usize + (w as u64 * texel) as usize];
+            if texel == 16 {
+                out.extend(bytemuck::pod_collect_to_vec::<u8, Vec4>(line));
+            } else {
+                // Halves, decoded by the shared binary16 function; ∞ (a value past 65504
+                // written by the render target) is read as the largest half.
+                let h = |k: usize| {
+                    let v = splitsum_shaders::half::f16_bits_to_f32(u16::from_le_bytes([line[2 * k], line[2 * k + 1]]) as u32);
+                    if v.is_infinite() { v.signum() * 65504.0 } else { v }
+                };
+                out.extend((0..w as usize).map(|x| Vec4::new(h(4 * x), h(4 * x + 1), h(4 * x + 2), h(4 * x + 3))));
+            }
         }
         Ok(out)
     }

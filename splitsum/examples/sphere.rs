@@ -31,11 +31,12 @@ pub struct Picture {
     pub pixels: Vec<[f32; 4]>,
 }
 
-/// The application's own device: the first adapter wgpu offers (lavapipe where there is
-/// no GPU).
+/// The application's own device: the first adapter wgpu offers on the APIs `WGPU_BACKEND`
+/// names (all, if unset; lavapipe or llvmpipe where there is no GPU).
 pub fn open_device() -> (wgpu::Device, wgpu::Queue) {
-    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor { backends: wgpu::Backends::VULKAN, ..wgpu::InstanceDescriptor::new_without_display_handle() });
-    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default())).expect("a Vulkan adapter (lavapipe works)");
+    let backends = wgpu::Backends::from_env().unwrap_or_default();
+    let instance = wgpu::Instance::new(wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle() });
+    let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default())).expect("a GPU adapter (lavapipe works)");
     pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor { label: Some("app"), required_limits: adapter.limits(), ..Default::default() }))
         .expect("a device")
 }
@@ -116,7 +117,7 @@ pub fn draw(
             module: &module,
             entry_point: Some("fs"),
             compilation_options: Default::default(),
-            targets: &[Some(wgpu::TextureFormat::Rgba32Float.into())],
+            targets: &[Some(wgpu::TextureFormat::Rgba16Float.into())],
         }),
         multiview_mask: None,
         cache: None,
@@ -138,11 +139,13 @@ pub fn draw(
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba32Float,
+        // Half floats, the usual HDR target, which every backend renders to (wgpu's GL
+        // backend renders to no 32-bit float format on some drivers).
+        format: wgpu::TextureFormat::Rgba16Float,
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     });
-    let row = (size * 16).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let row = (size * 8).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
     let readback = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("picture readback"),
         size: row as u64 * size as u64,
@@ -175,11 +178,15 @@ pub fn draw(
         target.size(),
     );
     queue.submit([encoder.finish()]);
-    let bytes = splitsum::backend::gpu::map_read(device, &readback)?;
+    let (tx, rx) = std::sync::mpsc::channel();
+    readback.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).expect("the receiver waits"));
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| splitsum::Error::Gpu(e.to_string()))?;
+    rx.recv().expect("mapped").map_err(|e| splitsum::Error::Gpu(e.to_string()))?;
+    let bytes = readback.slice(..).get_mapped_range().map_err(|e| splitsum::Error::Gpu(e.to_string()))?.to_vec();
     let pixels = (0..size as usize)
         .flat_map(|y| {
-            let line: &[[f32; 4]] = bytemuck::cast_slice(&bytes[y * row as usize..y * row as usize + size as usize * 16]);
-            line.to_vec()
+            let line: &[[u16; 4]] = bytemuck::cast_slice(&bytes[y * row as usize..y * row as usize + size as usize * 8]);
+            line.iter().map(|p| p.map(|h| half::f16::from_bits(h).to_f32())).collect::<Vec<_>>()
         })
         .collect();
     Ok(Picture { size, pixels })
@@ -198,7 +205,7 @@ fn main() -> splitsum::Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     // Reinhard and sRGB-ish gamma for a look; the pixels themselves are linear radiance.
     let rgb: Vec<u8> = picture.pixels.iter().flat_map(|p| [p[0], p[1], p[2]].map(|c| ((c / (1.0 + c)).powf(1.0 / 2.2) * 255.0).round() as u8)).collect();
-    splitsum::files::write_png(std::path::Path::new(&out), picture.size, picture.size, &rgb)?;
+    image::RgbImage::from_raw(picture.size, picture.size, rgb).expect("size² pixels").save(&out).map_err(|e| splitsum::Error::Invalid(format!("{out}: {e}")))?;
     println!("baked on {compute:?} and drew {out} in {seconds:.2} s (pipelines, bake, draw and the picture's readback)");
     Ok(())
 }

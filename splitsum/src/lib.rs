@@ -4,52 +4,105 @@
 //! environment, splitsum bakes what a PBR renderer reads for the split-sum approximation
 //! (Karis 2013, "Real Shading in Unreal Engine 4", §"Image-based lighting"): a cube
 //! prefiltered with the GGX lobe at one roughness per mip, the irradiance `E/π` for the
-//! diffuse term, and the BRDF table `(A, B)` that turns `F₀` into the specular reflectance.
+//! diffuse term, and the BRDF table `(A, B)` that turns `F₀` into the specular reflectance —
+//! on the caller's own `wgpu::Device` (Vulkan, Metal, DX12, GL: any backend wgpu offers),
+//! or natively on the CPU with the same functions.
 //!
-//! ```no_run
-//! # fn demo(device: &wgpu::Device, queue: &wgpu::Queue) -> splitsum::Result<()> {
-//! use splitsum::{Baker, Compute, Settings, Source, environment};
-//! let (env, _report) = environment::load(std::path::Path::new("sky.exr"), false)?;
-//! let baker = Baker::new(device, queue, Compute::Gpu)?;
-//! let ibl = baker.bake(Source::Environment(&env), &Settings::default())?;
-//! // Bind ibl.specular (cube, one roughness per mip), ibl.irradiance and ibl.brdf.
-//! # Ok(()) }
-//! ```
+//! ## A complete application
 //!
-//! The math lives once, in `splitsum-shaders` (no_std): rust-gpu compiles it to the SPIR-V
-//! module committed in `splitsum-spirv`, and the same functions compile natively for the
-//! CPU backend. Both backends implement [`backend::Kernels`]; [`bake`](mod@bake) is the one bake
-//! sequence over them; [`textures`] puts the products into the caller's textures.
+//! A device of its own, a bake on it, the three textures bound as a renderer binds them,
+//! and the files written (`examples/bake.rs`; `tests/library.rs` runs it on Vulkan, on GL
+//! and with [`Compute::Cpu`]):
 //!
-//! Modules, in the order data flows: [`environment`] (reading HDR files), [`settings`]
-//! (what to bake; one set of defaults, one validation), [`backend`] (CPU and GPU),
-//! [`bake`](mod@bake), [`textures`] (the wgpu API), [`output`] and [`ktx2`] (files), [`cache`]
-//! (baked products by content), [`cost`] (estimates before a bake runs).
+#![doc = concat!("```no_run\n", include_str!("../examples/bake.rs"), "\n```")]
+//!
+//! ## What is where
+//!
+//! - [`Baker`] bakes into textures on your device ([`Ibl`]: the specular cube with one
+//!   roughness per mip, the irradiance cube, the table); [`Ibl::layout_entries`] and
+//!   [`Ibl::views`] bind them, [`Ibl::lod`] says which mip a roughness reads, [`Ibl::read`]
+//!   brings them back.
+//! - [`Settings`] is every knob, with one set of defaults; a field left `None` is derived
+//!   ([`Settings::resolve`], the one validation, gives the [`Job`] the bake runs). Errors
+//!   name the field ([`Error::Setting`], [`Field`]).
+//! - [`environment`] reads `.hdr`, `.exr` and six-face folders, with bounded memory;
+//!   [`output::write`] writes the files of a [`Target`] (splitsum's folder, or what the glTF
+//!   Sample Viewer, Bevy or Filament load) as a folder replaced whole; [`bake()`] bakes
+//!   into host memory on a [`Backend`] for tools that need no device of their own.
+//! - Every formula lives in `splitsum-shaders` (no_std), compiled by rust-gpu to the SPIR-V
+//!   module committed in `splitsum-spirv` and natively for the CPU.
+//!
+//! The library prints nothing (notes go to the `log` crate). In a debug build of your
+//! application compile splitsum optimised (`[profile.dev.package."*"] opt-level = 2`): the
+//! CPU backend is several times slower unoptimised.
+//!
+//! The feature `internals` makes public the modules the `runner` command line, its display
+//! and its report are built from (backends' kernels, cache, cost model, progress, file
+//! plumbing): they are not part of the stable API. `embedded-environment` embeds the CC0
+//! courtyard HDRI the command line shows when given none.
 
 #![warn(missing_docs)]
 
+/// Declares modules public with the `internals` feature and private without it.
+macro_rules! internal_modules {
+    ($($(#[$meta:meta])* $name:ident;)*) => {
+        $(
+            $(#[$meta])*
+            #[cfg(feature = "internals")]
+            pub mod $name;
+            $(#[$meta])*
+            #[cfg(not(feature = "internals"))]
+            #[allow(dead_code, unused_imports)]
+            mod $name;
+        )*
+    };
+}
+
 pub mod adjustment;
-pub mod backend;
-pub mod bake;
-pub mod cache;
-pub mod cost;
 pub mod environment;
 pub mod error;
 pub mod field;
-pub mod files;
-pub mod host;
-pub mod ktx1;
-pub mod ktx2;
 pub mod output;
-pub mod preview;
-pub mod progress;
 pub mod settings;
 pub mod texture;
 pub mod textures;
 
-pub use backend::{Backend, BackendKind};
-pub use bake::{Baked, BakedEnvironment, bake};
-pub use environment::Environment;
+internal_modules! {
+    /// The CPU and GPU backends and the operations a bake is made of.
+    backend;
+    /// The one bake sequence over a backend.
+    bake;
+    /// Bakes by content, for scenes.
+    cache;
+    /// What a bake costs before it runs.
+    cost;
+    /// Output folders as units, atomic files, picture formats.
+    files;
+    /// Host-data conveniences over the backends.
+    host;
+    /// KTX 1.1 files (Filament).
+    ktx1;
+    /// KTX2 files.
+    ktx2;
+    /// Tonemapped previews.
+    preview;
+    /// Progress on stderr, for the command line.
+    progress;
+}
+
+pub use adjustment::Adjustment;
+pub use crate::backend::{Backend, BackendKind, Gpu};
+pub use crate::bake::{Baked, Timing, bake, bake_job};
+pub use environment::{Environment, InputReport, InputShape};
 pub use error::{Error, Result};
-pub use settings::{Products, Settings, Target};
-pub use textures::{Baker, Compute, Ibl, Source};
+pub use field::{Field, Step};
+pub use crate::ktx2::{Format, Written};
+pub use output::{About, Manifest};
+pub use settings::{Job, Products, Settings, TableMethod, Target};
+pub use splitsum_shaders::brdf::microfacet::Masking;
+pub use splitsum_shaders::choice::Choice;
+pub use splitsum_shaders::cubemap::CubeLayout;
+pub use splitsum_shaders::equirect::Facing;
+pub use splitsum_shaders::glam;
+pub use splitsum_shaders::prefilter::RoughnessMapping;
+pub use textures::{Baker, Compute, Ibl, IblViews, Source};

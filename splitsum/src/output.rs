@@ -151,10 +151,9 @@ struct ShFile<'a> {
 /// Writes the baked products of `job` as the folder `out` (replaced as a unit, and only
 /// if everything in it is what splitsum wrote there: `files::OutputDir`), in the files of
 /// `job.target`, with `bake.json`. The folder's name names the bake where a target's file
-/// names carry it (Filament's `NAME_ibl.ktx`), as cmgen's `--deploy` folder; `called` is
-/// what the caller calls `out`, for messages.
-pub fn write(out: &Path, called: &str, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
-    let folder = files::OutputDir::begin(out, called)?;
+/// names carry it (Filament's `NAME_ibl.ktx`), as cmgen's `--deploy` folder.
+pub fn write(out: &Path, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
+    let folder = files::OutputDir::begin(out, "the output folder")?;
     let name = out.file_name().map_or_else(|| "ibl".into(), |n| n.to_string_lossy().into_owned());
     let manifest = write_into(folder.path(), &name, baked, job, about)?;
     folder.commit()?;

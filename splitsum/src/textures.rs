@@ -65,6 +65,29 @@ pub struct Ibl {
     pub mapping: RoughnessMapping,
     /// Wall time of each step.
     pub timings: Vec<Timing>,
+    /// The bake, resolved: every setting it used (what `output::write` records).
+    pub job: Job,
+}
+
+/// The views a renderer binds ([`Ibl::views`]): the two cubes as `Cube` views of every
+/// mip, the table as a 2D view.
+pub struct IblViews {
+    /// The prefiltered specular cube.
+    pub specular: wgpu::TextureView,
+    /// The irradiance cube (`E/π`).
+    pub irradiance: wgpu::TextureView,
+    /// The BRDF table.
+    pub brdf: wgpu::TextureView,
+}
+
+impl IblViews {
+    /// Bind group entries for the specular cube, the irradiance cube and the table at
+    /// bindings `first`, `first + 1` and `first + 2` (as [`Ibl::layout_entries`] lays them
+    /// out).
+    pub fn entries(&self, first: u32) -> [wgpu::BindGroupEntry<'_>; 3] {
+        let entry = |k: u32, view| wgpu::BindGroupEntry { binding: first + k, resource: wgpu::BindingResource::TextureView(view) };
+        [entry(0, &self.specular), entry(1, &self.irradiance), entry(2, &self.brdf)]
+    }
 }
 
 /// Bakes on the caller's device.
@@ -170,7 +193,7 @@ impl Baker {
 
     fn ibl(&self, job: &Job, textures: (wgpu::Texture, wgpu::Texture, wgpu::Texture), timings: Vec<Timing>) -> Ibl {
         let (specular, irradiance, brdf) = textures;
-        Ibl { specular, irradiance, brdf, roughness: job.roughness_per_mip.clone(), mapping: job.mapping, timings }
+        Ibl { specular, irradiance, brdf, roughness: job.roughness_per_mip.clone(), mapping: job.mapping, timings, job: job.clone() }
     }
 
     /// Packs the products on the device and copies them into the textures.
@@ -410,6 +433,27 @@ fn cube_from_texture(g: &Gpu, texels: Texels, face: u32, job: &Job) -> Result<(T
 }
 
 impl Ibl {
+    /// Bind group layout entries for the specular cube, the irradiance cube (both
+    /// `texture_cube<f32>`) and the table (`texture_2d<f32>`), filterable float textures at
+    /// bindings `first`, `first + 1` and `first + 2`, visible to `visibility`. Sample them
+    /// with a linear, mipmapped sampler: the specular cube at [`Ibl::lod`] of the surface's
+    /// roughness, the irradiance along the normal, the table at `(n·v, roughness)`.
+    pub fn layout_entries(first: u32, visibility: wgpu::ShaderStages) -> [wgpu::BindGroupLayoutEntry; 3] {
+        let entry = |k: u32, view_dimension| wgpu::BindGroupLayoutEntry {
+            binding: first + k,
+            visibility,
+            ty: wgpu::BindingType::Texture { sample_type: wgpu::TextureSampleType::Float { filterable: true }, view_dimension, multisampled: false },
+            count: None,
+        };
+        [entry(0, wgpu::TextureViewDimension::Cube), entry(1, wgpu::TextureViewDimension::Cube), entry(2, wgpu::TextureViewDimension::D2)]
+    }
+
+    /// The views a renderer binds (see [`Ibl::layout_entries`]).
+    pub fn views(&self) -> IblViews {
+        let cube = |t: &wgpu::Texture| t.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::Cube), ..Default::default() });
+        IblViews { specular: cube(&self.specular), irradiance: cube(&self.irradiance), brdf: self.brdf.create_view(&Default::default()) }
+    }
+
     /// The specular mip (fractional, for trilinear lookups) that holds `roughness`.
     pub fn lod(&self, roughness: f32) -> f32 {
         self.mapping.lod(roughness, self.roughness.len() as u32)

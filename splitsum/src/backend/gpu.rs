@@ -199,6 +199,7 @@ impl Gpu {
     /// splitsum's work runs on the caller's queue and its textures live on that device).
     pub fn on_device(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Self> {
         let info = device.adapter_info();
+        check_limits(&info, &device.limits())?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("splitsum-shaders"),
@@ -334,6 +335,43 @@ impl Gpu {
         self.queue.submit([encoder.finish()]);
         map_read(&self.device, &staging)
     }
+}
+
+/// Refuses a device whose limits cannot run the kernels, naming what is missing: compute
+/// shaders with 8×8 workgroups, two storage buffers and a uniform block per kernel, and
+/// the largest parameter block. (A step whose buffer exceeds the storage binding limit runs
+/// on the CPU instead, with a note: see `Gpu::fits`.)
+fn check_limits(info: &wgpu::AdapterInfo, l: &wgpu::Limits) -> Result<()> {
+    let widest = spirv::KERNELS.iter().map(|k| k.workgroup_size).fold([1, 1, 1], |a, b| [a[0].max(b[0]), a[1].max(b[1]), a[2].max(b[2])]);
+    let invocations = spirv::KERNELS.iter().map(|k| k.workgroup_size.iter().product::<u32>()).max().unwrap_or(1);
+    let storage = spirv::KERNELS.iter().map(|k| k.bindings.iter().filter(|b| matches!(b.resource, Resource::Storage { .. })).count() as u32).max().unwrap_or(0);
+    let mut missing = Vec::new();
+    if l.max_compute_invocations_per_workgroup == 0 {
+        missing.push("compute shaders (a WebGL2-class device has none)".to_string());
+    } else {
+        if l.max_compute_invocations_per_workgroup < invocations {
+            missing.push(format!("{invocations} compute invocations per workgroup (it has {})", l.max_compute_invocations_per_workgroup));
+        }
+        let has = [l.max_compute_workgroup_size_x, l.max_compute_workgroup_size_y, l.max_compute_workgroup_size_z];
+        if (0..3).any(|k| has[k] < widest[k]) {
+            missing.push(format!("workgroups of {}×{}×{} (it has {}×{}×{})", widest[0], widest[1], widest[2], has[0], has[1], has[2]));
+        }
+    }
+    if l.max_storage_buffers_per_shader_stage < storage {
+        missing.push(format!("{storage} storage buffers per shader stage (it has {})", l.max_storage_buffers_per_shader_stage));
+    }
+    if l.max_uniform_buffers_per_shader_stage < 1 {
+        missing.push("a uniform buffer per shader stage".into());
+    }
+    if missing.is_empty() {
+        return Ok(());
+    }
+    Err(Error::Gpu(format!(
+        "{} ({}) cannot run splitsum's kernels: it lacks {}; bake on the CPU instead (Compute::Cpu)",
+        info.name,
+        api_name(info.backend),
+        missing.join(", ")
+    )))
 }
 
 /// Whether `device` copies cube textures to buffers. wgpu's GL backend makes every square
