@@ -68,25 +68,15 @@ pub mod texture;
 pub mod textures;
 
 internal_modules! {
-    /// The CPU and GPU backends and the operations a bake is made of.
     backend;
-    /// The one bake sequence over a backend.
     bake;
-    /// Bakes by content, for scenes.
     cache;
-    /// What a bake costs before it runs.
     cost;
-    /// Output folders as units, atomic files, picture formats.
     files;
-    /// Host-data conveniences over the backends.
     host;
-    /// KTX 1.1 files (Filament).
     ktx1;
-    /// KTX2 files.
     ktx2;
-    /// Tonemapped previews.
     preview;
-    /// Progress on stderr, for the command line.
     progress;
 }
 
