@@ -158,7 +158,7 @@ pub fn adapters(instance: &wgpu::Instance, backends: wgpu::Backends, filter: Opt
 }
 
 impl Gpu {
-    /// Opens the best adapter (see [`adapters`]) on the APIs `WGPU_BACKEND` names (all, if
+    /// Opens the best adapter (discrete, integrated, virtual, then CPU; Vulkan, Metal, DX12, then GL) on the APIs `WGPU_BACKEND` names (all, if
     /// unset) whose name contains `WGPU_ADAPTER_NAME` (any, if unset), wgpu's own
     /// variables, and builds every pipeline.
     pub fn new() -> Result<Self> {
