@@ -277,3 +277,46 @@ fn a_device_that_cannot_run_the_kernels_is_refused_by_name() {
     let ibl = Baker::new(&d, &q, Compute::Cpu).unwrap().bake(Source::Environment(&constant(1.0)), &small()).unwrap();
     assert_eq!(ibl.specular.mip_level_count(), Settings::default_mips(16));
 }
+
+/// splitsum in a browser: the library built for wasm32 bakes on headless Chromium's
+/// WebGPU device (SwiftShader) through `tests/webgpu` (wasm-bindgen, puppeteer-core), and
+/// the textures it reads back agree with a CPU bake of the same environment within a half
+/// float's step (2⁻¹⁰ relative above 10⁻³ of the peak), as on Vulkan and GL. Needs what
+/// `bash scripts/webgpu.sh` builds and installs (it runs this test); ignored otherwise.
+#[test]
+#[ignore = "needs Chromium and the wasm build: bash scripts/webgpu.sh"]
+fn a_bake_in_the_browsers_webgpu_matches_the_cpu() {
+    let (w, h, size) = (64u32, 32u32, 16u32);
+    let mut texels = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let sun = (x as i32 - 20).pow(2) + (y as i32 - 10).pow(2) < 3;
+            let v = if sun { 500.0 } else { 0.2 + 0.8 * (1.0 - y as f32 / h as f32) };
+            texels.push(Vec4::new(0.6 * v, 0.8 * v, v, 1.0));
+        }
+    }
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/webgpu");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut input: Vec<u8> = [w, h, size].iter().flat_map(|v| v.to_le_bytes()).collect();
+    input.extend(texels.iter().flat_map(|t| [t.x, t.y, t.z]).flat_map(f32::to_le_bytes));
+    let (inp, out) = (dir.join("input.bin"), dir.join("output.bin"));
+    std::fs::write(&inp, input).unwrap();
+    let _ = std::fs::remove_file(&out);
+    let script = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("webgpu/run.mjs");
+    let status = std::process::Command::new("node").arg(&script).arg(&inp).arg(&out).status().expect("node");
+    assert!(status.success(), "node {}", script.display());
+    if let Ok(message) = std::fs::read_to_string(out.with_extension("bin.err")) {
+        panic!("the browser refused the bake: {message}");
+    }
+    let got: Vec<f32> = std::fs::read(&out).unwrap().chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect();
+    let env = Environment::Equirect(Equirect { width: w, height: h, texels });
+    let settings = Settings { size, irradiance_size: 8, lut_size: 32, ..Settings::default() };
+    let (d, q) = device();
+    let cpu = Baker::new(d, q, Compute::Cpu).unwrap().bake(Source::Environment(&env), &settings).unwrap().read(d, q).map(data).unwrap();
+    let want: Vec<f32> = cpu.specular.texels.iter().chain(&cpu.irradiance.texels).flat_map(|v| v.to_array()).chain(cpu.brdf.iter().flat_map(|t| [t.x, t.y])).collect();
+    assert_eq!(got.len(), want.len(), "specular, irradiance and table values");
+    let peak = want.iter().copied().fold(0.0f32, f32::max);
+    let worst = got.iter().zip(&want).map(|(a, b)| (a - b).abs() / b.abs().max(1e-3 * peak)).fold(0.0f32, f32::max);
+    eprintln!("WebGPU in Chromium against the CPU: largest relative difference {worst:.2e} ({})", std::fs::read_to_string(out.with_extension("bin.txt")).unwrap_or_default());
+    assert!(worst <= 2.0f32.powi(-10), "{worst:.2e}");
+}

@@ -220,7 +220,7 @@ pub fn prefilter_specular(
     }
 }
 
-/// Parameters of [`irradiance_cube`] and [`irradiance_sh9`].
+/// Parameters of [`irradiance_cube`] and [`irradiance_sh9_project`].
 #[derive(Copy, Clone, Debug, Pod, Zeroable)]
 #[repr(C)]
 pub struct IrradianceParams {
@@ -260,7 +260,7 @@ pub fn irradiance_cube(
 /// The SH9 partial sums of one row (`id.x`) of one face (`id.z`) of the source level:
 /// ten `Vec4` per row (see [`irradiance::sh9_row`]).
 #[spirv(compute(threads(64)))]
-pub fn irradiance_sh9(
+pub fn irradiance_sh9_project(
     #[spirv(global_invocation_id)] id: UVec3,
     #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &IrradianceParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],

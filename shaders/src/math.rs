@@ -26,6 +26,13 @@ use spirv_std::num_traits::Float;
 /// roughness times a sun), so with inputs ≤ 10²⁰ nothing reaches f32::MAX ≈ 3.4·10³⁸.
 pub const MAX_RADIANCE: f32 = 1e20;
 
+/// The largest value a result is held to, in place of `f32::MAX`: naga writes `f32::MAX`
+/// for WGSL as `340282350000000000000000000000000000000f`, which exceeds `f32::MAX` before
+/// rounding and which browsers' WGSL compilers (Chromium's Tint) refuse ("value cannot be
+/// represented as 'f32'"); 3.4·10³⁸ is written as a literal they take, and every value the
+/// bake makes stays far below it (inputs are clamped at [`MAX_RADIANCE`]).
+pub const LARGEST: f32 = 3.4e38;
+
 /// π in f32.
 pub const PI: f32 = core::f32::consts::PI;
 /// 1/π in f32.
@@ -137,11 +144,11 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 }
 
 /// 2^x, exact at integers; `0` below the subnormal range. For `x ≥ 128` it saturates to
-/// `f32::MAX` rather than overflowing (and naga rejects infinite constants in shaders).
+/// [`LARGEST`] rather than overflowing (and naga rejects infinite constants in shaders).
 #[inline]
 pub fn exp2(x: f32) -> f32 {
     if x >= 128.0 {
-        return f32::MAX;
+        return LARGEST;
     }
     if x < -150.0 {
         return 0.0;
@@ -168,7 +175,7 @@ pub fn log2(x: f32) -> f32 {
     if !(x > 0.0) {
         return LOG2_FLOOR;
     }
-    if x > f32::MAX {
+    if x > LARGEST {
         return 128.0;
     }
     let mut bits = x.to_bits();
@@ -219,13 +226,13 @@ pub fn saturate(x: f32) -> f32 {
     clamp(x, 0.0, 1.0)
 }
 
-/// `v` with every channel above `f32::MAX` (an infinity born of rounding in a weighted mean
-/// of values near `f32::MAX`) brought back to `f32::MAX`. A weighted mean of finite inputs
-/// is mathematically at most their maximum; this keeps it finite when rounding says
+/// `v` with every channel above [`LARGEST`] (an infinity born of rounding in a weighted
+/// mean of values near `f32::MAX`) brought back to [`LARGEST`]. A weighted mean of finite
+/// inputs is mathematically at most their maximum; this keeps it finite when rounding says
 /// otherwise.
 #[inline]
 pub fn finite4(v: Vec4) -> Vec4 {
-    let c = |x: f32| if x > f32::MAX { f32::MAX } else { x };
+    let c = |x: f32| if x > LARGEST { LARGEST } else { x };
     Vec4::new(c(v.x), c(v.y), c(v.z), c(v.w))
 }
 

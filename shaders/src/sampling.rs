@@ -92,5 +92,5 @@ pub fn reflect(v: Vec3, h: Vec3) -> Vec3 {
 #[inline]
 pub fn normalize_or(v: Vec3, fallback: Vec3) -> Vec3 {
     let len2 = v.dot(v);
-    if len2 > 1e-30 && len2 <= f32::MAX { v * (1.0 / math::sqrt(len2)) } else { fallback }
+    if len2 > 1e-30 && len2 <= math::LARGEST { v * (1.0 / math::sqrt(len2)) } else { fallback }
 }

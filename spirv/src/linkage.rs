@@ -3,18 +3,18 @@
 
 use crate::{Binding, Dimension, EntryPoint, Resource, Stage};
 
-/// `display::fullscreen_vs`.
+/// `display_fullscreen_vs`.
 pub const DISPLAY_FULLSCREEN_VS: EntryPoint = EntryPoint {
-    name: "display::fullscreen_vs",
+    name: "display_fullscreen_vs",
     stage: Stage::Vertex,
     workgroup_size: [1, 1, 1],
     bindings: &[
     ],
 };
 
-/// `display::mesh_fs`.
+/// `display_mesh_fs`.
 pub const DISPLAY_MESH_FS: EntryPoint = EntryPoint {
-    name: "display::mesh_fs",
+    name: "display_mesh_fs",
     stage: Stage::Fragment,
     workgroup_size: [1, 1, 1],
     bindings: &[
@@ -32,9 +32,9 @@ pub const DISPLAY_MESH_FS: EntryPoint = EntryPoint {
     ],
 };
 
-/// `display::mesh_vs`.
+/// `display_mesh_vs`.
 pub const DISPLAY_MESH_VS: EntryPoint = EntryPoint {
-    name: "display::mesh_vs",
+    name: "display_mesh_vs",
     stage: Stage::Vertex,
     workgroup_size: [1, 1, 1],
     bindings: &[
@@ -42,9 +42,9 @@ pub const DISPLAY_MESH_VS: EntryPoint = EntryPoint {
     ],
 };
 
-/// `display::scene_fs`.
+/// `display_scene_fs`.
 pub const DISPLAY_SCENE_FS: EntryPoint = EntryPoint {
-    name: "display::scene_fs",
+    name: "display_scene_fs",
     stage: Stage::Fragment,
     workgroup_size: [1, 1, 1],
     bindings: &[
@@ -56,9 +56,9 @@ pub const DISPLAY_SCENE_FS: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::brdf_lut`.
+/// `kernels_brdf_lut`.
 pub const KERNELS_BRDF_LUT: EntryPoint = EntryPoint {
-    name: "kernels::brdf_lut",
+    name: "kernels_brdf_lut",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -67,9 +67,9 @@ pub const KERNELS_BRDF_LUT: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::brdf_table`.
+/// `kernels_brdf_table`.
 pub const KERNELS_BRDF_TABLE: EntryPoint = EntryPoint {
-    name: "kernels::brdf_table",
+    name: "kernels_brdf_table",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -78,9 +78,9 @@ pub const KERNELS_BRDF_TABLE: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::downsample`.
+/// `kernels_downsample`.
 pub const KERNELS_DOWNSAMPLE: EntryPoint = EntryPoint {
-    name: "kernels::downsample",
+    name: "kernels_downsample",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -89,9 +89,9 @@ pub const KERNELS_DOWNSAMPLE: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::equirect_pyramid`.
+/// `kernels_equirect_pyramid`.
 pub const KERNELS_EQUIRECT_PYRAMID: EntryPoint = EntryPoint {
-    name: "kernels::equirect_pyramid",
+    name: "kernels_equirect_pyramid",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -100,9 +100,9 @@ pub const KERNELS_EQUIRECT_PYRAMID: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::equirect_to_cube`.
+/// `kernels_equirect_to_cube`.
 pub const KERNELS_EQUIRECT_TO_CUBE: EntryPoint = EntryPoint {
-    name: "kernels::equirect_to_cube",
+    name: "kernels_equirect_to_cube",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -112,9 +112,9 @@ pub const KERNELS_EQUIRECT_TO_CUBE: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::irradiance_cube`.
+/// `kernels_irradiance_cube`.
 pub const KERNELS_IRRADIANCE_CUBE: EntryPoint = EntryPoint {
-    name: "kernels::irradiance_cube",
+    name: "kernels_irradiance_cube",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -124,9 +124,9 @@ pub const KERNELS_IRRADIANCE_CUBE: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::irradiance_sh9`.
-pub const KERNELS_IRRADIANCE_SH9: EntryPoint = EntryPoint {
-    name: "kernels::irradiance_sh9",
+/// `kernels_irradiance_sh9_project`.
+pub const KERNELS_IRRADIANCE_SH9_PROJECT: EntryPoint = EntryPoint {
+    name: "kernels_irradiance_sh9_project",
     stage: Stage::Compute,
     workgroup_size: [64, 1, 1],
     bindings: &[
@@ -136,9 +136,9 @@ pub const KERNELS_IRRADIANCE_SH9: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::pack_half`.
+/// `kernels_pack_half`.
 pub const KERNELS_PACK_HALF: EntryPoint = EntryPoint {
-    name: "kernels::pack_half",
+    name: "kernels_pack_half",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -148,9 +148,9 @@ pub const KERNELS_PACK_HALF: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::prefilter_mirror`.
+/// `kernels_prefilter_mirror`.
 pub const KERNELS_PREFILTER_MIRROR: EntryPoint = EntryPoint {
-    name: "kernels::prefilter_mirror",
+    name: "kernels_prefilter_mirror",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -160,9 +160,9 @@ pub const KERNELS_PREFILTER_MIRROR: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::prefilter_specular`.
+/// `kernels_prefilter_specular`.
 pub const KERNELS_PREFILTER_SPECULAR: EntryPoint = EntryPoint {
-    name: "kernels::prefilter_specular",
+    name: "kernels_prefilter_specular",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -172,9 +172,9 @@ pub const KERNELS_PREFILTER_SPECULAR: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::probe`.
+/// `kernels_probe`.
 pub const KERNELS_PROBE: EntryPoint = EntryPoint {
-    name: "kernels::probe",
+    name: "kernels_probe",
     stage: Stage::Compute,
     workgroup_size: [64, 1, 1],
     bindings: &[
@@ -184,9 +184,9 @@ pub const KERNELS_PROBE: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::read_cube`.
+/// `kernels_read_cube`.
 pub const KERNELS_READ_CUBE: EntryPoint = EntryPoint {
-    name: "kernels::read_cube",
+    name: "kernels_read_cube",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -197,9 +197,9 @@ pub const KERNELS_READ_CUBE: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::resolve_lut`.
+/// `kernels_resolve_lut`.
 pub const KERNELS_RESOLVE_LUT: EntryPoint = EntryPoint {
-    name: "kernels::resolve_lut",
+    name: "kernels_resolve_lut",
     stage: Stage::Compute,
     workgroup_size: [64, 1, 1],
     bindings: &[
@@ -209,9 +209,9 @@ pub const KERNELS_RESOLVE_LUT: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::resolve_means`.
+/// `kernels_resolve_means`.
 pub const KERNELS_RESOLVE_MEANS: EntryPoint = EntryPoint {
-    name: "kernels::resolve_means",
+    name: "kernels_resolve_means",
     stage: Stage::Compute,
     workgroup_size: [64, 1, 1],
     bindings: &[
@@ -221,9 +221,9 @@ pub const KERNELS_RESOLVE_MEANS: EntryPoint = EntryPoint {
     ],
 };
 
-/// `kernels::unpack_rows`.
+/// `kernels_unpack_rows`.
 pub const KERNELS_UNPACK_ROWS: EntryPoint = EntryPoint {
-    name: "kernels::unpack_rows",
+    name: "kernels_unpack_rows",
     stage: Stage::Compute,
     workgroup_size: [8, 8, 1],
     bindings: &[
@@ -234,4 +234,4 @@ pub const KERNELS_UNPACK_ROWS: EntryPoint = EntryPoint {
 };
 
 /// Every compute entry point.
-pub const KERNELS: [EntryPoint; 15] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9, KERNELS_PACK_HALF, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];
+pub const KERNELS: [EntryPoint; 15] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9_PROJECT, KERNELS_PACK_HALF, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];

@@ -14,7 +14,7 @@ use serde::Serialize;
 use splitsum_shaders::cubemap::{self, CubeLayout};
 use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::shade::EnvironmentShape;
-use std::time::Instant;
+use web_time::Instant;
 
 /// Wall time of one step.
 #[derive(Clone, Debug, Serialize)]

@@ -455,7 +455,9 @@ static PENDING: std::sync::Mutex<Vec<(PathBuf, Vec<PathBuf>)>> = std::sync::Mute
 /// installs it; an application with its own handling leaves it out (its interrupted runs
 /// may then leave a hidden `.NAME.splitsum-PID` folder beside the output).
 pub fn remove_staging_on_interrupt() {
+    #[cfg(not(target_arch = "wasm32"))]
     static ONCE: std::sync::Once = std::sync::Once::new();
+    #[cfg(not(target_arch = "wasm32"))]
     ONCE.call_once(|| {
         // ctrlc runs this on its own thread, so it may take locks and touch files.
         let _ = ctrlc::set_handler(|| {
@@ -625,6 +627,7 @@ fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
 /// Swaps the folders `a` and `b` with two renames (no atomic exchange on this system: for
 /// a moment `b` does not exist, but it never holds a mix).
 #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+#[allow(dead_code)]
 fn exchange(a: &Path, b: &Path) -> std::io::Result<()> {
     let aside = a.with_extension("old");
     std::fs::rename(b, &aside)?;

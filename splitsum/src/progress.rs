@@ -51,8 +51,10 @@ pub fn bar(what: &str, len: u64) -> ProgressBar {
     bar
 }
 
-/// A step of a run, shown until dropped.
-pub struct Step(ProgressBar);
+/// A step of a run, shown until dropped (nothing at all where progress is not shown: no
+/// bar is made, so that a library in a browser, where indicatif's clock does not run,
+/// never touches one).
+pub struct Step(Option<ProgressBar>);
 
 /// Starts step `what`, estimated to take `estimate` seconds (if known).
 pub fn step(what: &str, estimate: Option<f64>) -> Step {
@@ -61,23 +63,25 @@ pub fn step(what: &str, estimate: Option<f64>) -> Step {
         _ => String::new(),
     };
     if !shown() {
-        return Step(ProgressBar::hidden());
+        return Step(None);
     }
     if !interactive() {
         eprintln!("{what}…{est}");
-        return Step(ProgressBar::hidden());
+        return Step(None);
     }
     let bar = MULTI.add(ProgressBar::new_spinner());
     bar.set_style(ProgressStyle::with_template("{spinner} {prefix} {elapsed}{msg}").expect("valid template"));
     bar.set_prefix(what.to_string());
     bar.set_message(est);
     bar.enable_steady_tick(Duration::from_millis(120));
-    Step(bar)
+    Step(Some(bar))
 }
 
 impl Drop for Step {
     fn drop(&mut self) {
-        self.0.finish_and_clear();
+        if let Some(bar) = &self.0 {
+            bar.finish_and_clear();
+        }
     }
 }
 

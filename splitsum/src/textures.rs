@@ -107,8 +107,14 @@ impl Baker {
     /// the caller's queue). With [`Compute::Gpu`] this builds the kernels' pipelines (once;
     /// keep the baker to bake again without that cost).
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, compute: Compute) -> Result<Self> {
+        pollster::block_on(Self::new_async(device, queue, compute))
+    }
+
+    /// [`Baker::new`] without blocking: what a browser (wgpu's WebGPU backend) needs, where
+    /// nothing may block; natively the same.
+    pub async fn new_async(device: &wgpu::Device, queue: &wgpu::Queue, compute: Compute) -> Result<Self> {
         let gpu = match compute {
-            Compute::Gpu => Some(Gpu::on_device(device, queue)?),
+            Compute::Gpu => Some(Gpu::on_device_async(device, queue).await?),
             Compute::Cpu => None,
         };
         Ok(Self { device: device.clone(), queue: queue.clone(), gpu })
@@ -137,7 +143,7 @@ impl Baker {
                     Source::Texture(t) => {
                         let est = bake::step_estimates(true, &job);
                         let mut timings = Vec::new();
-                        let start = std::time::Instant::now();
+                        let start = web_time::Instant::now();
                         let (src, layout) = texture_source_cube(g, t, &job)?;
                         g.finish()?;
                         timings.push(Timing { step: Step::SourceCube, seconds: start.elapsed().as_secs_f64() });
@@ -319,7 +325,7 @@ impl Baker {
         if matches!(shape, Shape::Cube) && !gpu::copies_cubes(&self.device) {
             let size = texture.size().width;
             let layout = CubeLayout::new(size, 1);
-            let texels = read_cube(&self.device, &self.queue, texture, layout)?;
+            let texels = pollster::block_on(read_cube(&self.device, &self.queue, texture, layout))?;
             return Ok(Environment::Cube(Cube { layout, texels: texels.into_iter().map(|v| v.truncate().extend(1.0)).collect() }));
         }
         let (buffer, row, half) = self.copy_out(texture, wgpu::BufferUsages::MAP_READ)?;
@@ -364,7 +370,7 @@ fn texture_shape(t: &wgpu::Texture) -> Result<Shape> {
 /// Every level `layout` names of the cube `texture`, read on the device with the
 /// `read_cube` kernel (where the device cannot copy cubes, `gpu::copies_cubes`), into host
 /// memory.
-fn read_cube(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layout: CubeLayout) -> Result<Vec<Vec4>> {
+async fn read_cube(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture, layout: CubeLayout) -> Result<Vec<Vec4>> {
     let bytes = layout.texel_count() as u64 * 16;
     let out = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("splitsum cube texels"),
@@ -379,10 +385,10 @@ fn read_cube(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture
         mapped_at_creation: false,
     });
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum read cube") });
-    gpu::CubeReader::new(device, texture.format()).record(device, &mut encoder, texture, layout, &out);
+    gpu::CubeReader::new(device, texture.format()).record(device, queue, &mut encoder, texture, layout, &out);
     encoder.copy_buffer_to_buffer(&out, 0, &staging, 0, bytes);
     queue.submit([encoder.finish()]);
-    Ok(bytemuck::cast_slice(&gpu::map_read(device, &staging)?).to_vec())
+    Ok(bytemuck::cast_slice(&gpu::map_read_async(device, &staging).await?).to_vec())
 }
 
 /// The source cube of `job` from a texture on the device, without leaving it.
@@ -393,7 +399,7 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, job: &Job) -> Result<(T
         let count = CubeLayout::new(size, CubeLayout::full_chain(size)).texel_count();
         let texels = Texels { buffer: g.output("source texels", count as u64 * 16)?, count };
         let mut encoder = g.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum source cube") });
-        gpu::CubeReader::new(&g.device, texture.format()).record(&g.device, &mut encoder, texture, CubeLayout::new(size, 1), &texels.buffer);
+        gpu::CubeReader::new(&g.device, texture.format()).record(&g.device, &g.queue, &mut encoder, texture, CubeLayout::new(size, 1), &texels.buffer);
         g.queue.submit([encoder.finish()]);
         return cube_from_texture(g, texels, size, job);
     }
@@ -463,55 +469,60 @@ impl Ibl {
     /// products (the specular and irradiance cubes and the table; no source cube or SH9):
     /// for files (`output::write`), tests and inspection.
     pub fn read(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Baked> {
-        let read = |t: &wgpu::Texture, channels: u32| -> Result<Vec<Vec4>> {
-            let mut out = Vec::new();
-            let layers = t.size().depth_or_array_layers;
-            for m in 0..t.mip_level_count() {
-                let s = (t.size().width >> m).max(1);
-                let row = pitch(s * channels * 2);
-                let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("splitsum readback"),
-                    size: row as u64 * s as u64 * layers as u64,
-                    usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                });
-                let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-                encoder.copy_texture_to_buffer(
-                    wgpu::TexelCopyTextureInfo { texture: t, mip_level: m, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
-                    wgpu::TexelCopyBufferInfo {
-                        buffer: &buffer,
-                        layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(s) },
-                    },
-                    wgpu::Extent3d { width: s, height: s, depth_or_array_layers: layers },
-                );
-                queue.submit([encoder.finish()]);
-                let bytes = crate::backend::gpu::map_read(device, &buffer)?;
-                let words: &[u32] = bytemuck::cast_slice(&bytes);
-                for r in 0..(s * layers) as usize {
-                    let w = &words[r * (row / 4) as usize..];
-                    for x in 0..s as usize {
-                        let h = |k: usize| f16_bits_to_f32(if k % 2 == 0 { w[k / 2] & 0xffff } else { w[k / 2] >> 16 });
-                        let c = channels as usize * x;
-                        out.push(if channels == 4 { Vec4::new(h(c), h(c + 1), h(c + 2), h(c + 3)) } else { Vec4::new(h(c), h(c + 1), 0.0, 0.0) });
-                    }
-                }
-            }
-            Ok(out)
-        };
-        let cube = |t: &wgpu::Texture| -> Result<Cube> {
+        pollster::block_on(self.read_async(device, queue))
+    }
+
+    /// [`Ibl::read`] without blocking (in a browser, where nothing may block).
+    pub async fn read_async(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Baked> {
+        let cube = async |t: &wgpu::Texture| -> Result<Cube> {
             let layout = CubeLayout::new(t.size().width, t.mip_level_count());
-            let texels = if gpu::copies_cubes(device) { read(t, 4)? } else { read_cube(device, queue, t, layout)? };
+            let texels = if gpu::copies_cubes(device) { read_halves(device, queue, t, 4).await? } else { read_cube(device, queue, t, layout).await? };
             Ok(Cube { layout, texels })
         };
         let size = self.brdf.size().width;
-        let brdf = Lut { size, texels: read(&self.brdf, 2)?.into_iter().map(|v| v.truncate().truncate()).collect() };
+        let brdf = Lut { size, texels: read_halves(device, queue, &self.brdf, 2).await?.into_iter().map(|v| v.truncate().truncate()).collect() };
         Ok(Baked {
             source: None,
-            specular: Some(cube(&self.specular)?),
-            irradiance: Some(cube(&self.irradiance)?),
+            specular: Some(cube(&self.specular).await?),
+            irradiance: Some(cube(&self.irradiance).await?),
             sh9: None,
             lut: Some(brdf),
             timings: self.timings.clone(),
         })
     }
+}
+
+/// Every level and layer of the half-float texture `t` (`channels` per texel: 4, or 2 read
+/// as `(x, y, 0, 0)`) copied out and decoded.
+async fn read_halves(device: &wgpu::Device, queue: &wgpu::Queue, t: &wgpu::Texture, channels: u32) -> Result<Vec<Vec4>> {
+    let mut out = Vec::new();
+    let layers = t.size().depth_or_array_layers;
+    for m in 0..t.mip_level_count() {
+        let s = (t.size().width >> m).max(1);
+        let row = pitch(s * channels * 2);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("splitsum readback"),
+            size: row as u64 * s as u64 * layers as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo { texture: t, mip_level: m, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::All },
+            wgpu::TexelCopyBufferInfo { buffer: &buffer, layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(s) } },
+            wgpu::Extent3d { width: s, height: s, depth_or_array_layers: layers },
+        );
+        queue.submit([encoder.finish()]);
+        let bytes = gpu::map_read_async(device, &buffer).await.map_err(|e| Error::Gpu(format!("{e} ({:?} {:?}, mip {m} of {})", t.format(), t.size(), t.mip_level_count())))?;
+        let words: &[u32] = bytemuck::cast_slice(&bytes);
+        for r in 0..(s * layers) as usize {
+            let w = &words[r * (row / 4) as usize..];
+            for x in 0..s as usize {
+                let h = |k: usize| f16_bits_to_f32(if k % 2 == 0 { w[k / 2] & 0xffff } else { w[k / 2] >> 16 });
+                let c = channels as usize * x;
+                out.push(if channels == 4 { Vec4::new(h(c), h(c + 1), h(c + 2), h(c + 3)) } else { Vec4::new(h(c), h(c + 1), 0.0, 0.0) });
+            }
+        }
+    }
+    Ok(out)
 }

@@ -55,6 +55,8 @@ fn run(check: bool) -> Result<bool, Error> {
     let mut module = rspirv::dr::load_words(&words).map_err(|e| format!("reading the module back: {e}"))?;
     let rewritten = latch_conditions_local(&mut module);
     eprintln!("xtask: {rewritten} loop latches given a condition of their own (see latch_conditions_local)");
+    let renamed = wgsl_entry_names(&mut module)?;
+    eprintln!("xtask: {renamed} entry points named as WGSL identifiers (see wgsl_entry_names)");
     let spv: Vec<u8> = {
         use rspirv::binary::Assemble;
         module.assemble().iter().flat_map(|w| w.to_le_bytes()).collect()
@@ -154,6 +156,44 @@ fn latch_conditions_local(module: &mut Module) -> usize {
         h.bound = next_id;
     }
     rewritten
+}
+
+/// Names every entry point `module_function` instead of rust-gpu's `module::function`: in a
+/// browser wgpu hands the module to WebGPU as WGSL (naga's translation), where `::` is no
+/// identifier and naga renames the entry points, so a pipeline asking for
+/// `kernels::brdf_lut` finds none ("Entry point "kernels::brdf_lut" doesn't exist in the
+/// shader module"). Returns how many were renamed.
+///
+/// The debug name (`OpName`) of each entry point's function is dropped (naga would name
+/// that function too, and may rename the entry point to keep the names apart), and an entry
+/// name may not end in a digit: naga appends `_` to such a name (`kernels_irradiance_sh9`
+/// became `kernels_irradiance_sh9_`; Chromium: "Entry point "kernels_irradiance_sh9"
+/// doesn't exist in the shader module", and the device was lost with it).
+fn wgsl_entry_names(module: &mut Module) -> Result<usize, Error> {
+    let mut renamed = 0;
+    let mut functions = BTreeSet::new();
+    for e in &mut module.entry_points {
+        if let Some(Operand::IdRef(f)) = e.operands.get(1) {
+            functions.insert(*f);
+        }
+        for o in &mut e.operands {
+            if let Operand::LiteralString(name) = o
+                && name.contains("::")
+            {
+                *name = name.replace("::", "_");
+                renamed += 1;
+            }
+        }
+    }
+    module.debug_names.retain(|i| !(i.class.opcode == Op::Name && matches!(i.operands.first(), Some(Operand::IdRef(t)) if functions.contains(t))));
+    for e in &module.entry_points {
+        if let Some(Operand::LiteralString(name)) = e.operands.get(2)
+            && name.ends_with(|c: char| c.is_ascii_digit())
+        {
+            return Err(format!("entry point {name} ends in a digit, which naga renames for WGSL (browsers): rename the function").into());
+        }
+    }
+    Ok(renamed)
 }
 
 /// What a binding holds, as `splitsum_spirv::Resource` spells it.

@@ -21,7 +21,6 @@ use splitsum_shaders::{equirect, lut, prefilter};
 use splitsum_spirv::{self as spirv, Binding, Dimension, EntryPoint, Resource, Stage};
 use std::borrow::Cow;
 use std::collections::HashMap;
-use wgpu::util::DeviceExt;
 
 /// A wgpu device with every kernel's pipeline ready.
 pub struct Gpu {
@@ -198,6 +197,11 @@ impl Gpu {
     /// The kernels' pipelines on a device the caller opened (wgpu handles are shared, so
     /// splitsum's work runs on the caller's queue and its textures live on that device).
     pub fn on_device(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Self> {
+        pollster::block_on(Self::on_device_async(device, queue))
+    }
+
+    /// [`Gpu::on_device`] without blocking (in a browser, where nothing may block).
+    pub async fn on_device_async(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Self> {
         let info = device.adapter_info();
         check_limits(&info, &device.limits())?;
         let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -205,17 +209,20 @@ impl Gpu {
             label: Some("splitsum-shaders"),
             source: wgpu::ShaderSource::SpirV(Cow::Borrowed(splitsum_spirv::words())),
         });
-        let pipelines = splitsum_spirv::KERNELS
-            .iter()
-            // The cube reader binds a texture of the caller's format: built when needed.
-            .filter(|k| k.name != spirv::KERNELS_READ_CUBE.name)
-            .map(|k| {
-                let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
-                (k.name, (kernel_pipeline(device, &module, k, &layout), layout))
-            })
-            .collect();
-        if let Some(e) = pollster::block_on(scope.pop()) {
-            return Err(Error::Gpu(format!("the kernels did not validate on {}: {e}", info.name)));
+        if let Some(e) = scope.pop().await {
+            return Err(Error::Gpu(format!("the shader module did not validate on {}: {e}", info.name)));
+        }
+        // One pipeline at a time, each checked before the next: an error names its kernel.
+        let mut pipelines = HashMap::new();
+        // The cube reader binds a texture of the caller's format: built when needed.
+        for k in splitsum_spirv::KERNELS.iter().filter(|k| k.name != spirv::KERNELS_READ_CUBE.name) {
+            let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
+            let pipeline = kernel_pipeline(device, &module, k, &layout);
+            if let Some(e) = scope.pop().await {
+                return Err(Error::Gpu(format!("kernel {} did not validate on {}: {e}", k.name, info.name)));
+            }
+            pipelines.insert(k.name, (pipeline, layout));
         }
         let empty = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("empty input"),
@@ -239,11 +246,7 @@ impl Gpu {
 
     /// A storage buffer holding `data`.
     pub fn upload_bytes(&self, label: &str, data: &[u8]) -> wgpu::Buffer {
-        self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: data,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        })
+        filled(&self.device, &self.queue, label, data, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST)
     }
 
     /// The largest buffer this device binds as one storage buffer.
@@ -277,11 +280,7 @@ impl Gpu {
             .map(|d| {
                 let mut bytes = d.params.to_vec();
                 bytes.resize(bytes.len().next_multiple_of(16).max(16), 0);
-                self.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("params"),
-                    contents: &bytes,
-                    usage: wgpu::BufferUsages::UNIFORM,
-                })
+                filled(&self.device, &self.queue, "params", &bytes, wgpu::BufferUsages::UNIFORM)
             })
             .collect();
         let groups: Vec<wgpu::BindGroup> = dispatches
@@ -422,7 +421,7 @@ impl CubeReader {
 
     /// Records the reading of every mip of the cube `texture` into `out`, texels laid out
     /// as `layout` (level by level, face by face), cleaned (`half::clean_radiance`).
-    pub fn record(&self, device: &wgpu::Device, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, layout: CubeLayout, out: &wgpu::Buffer) {
+    pub fn record(&self, device: &wgpu::Device, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, layout: CubeLayout, out: &wgpu::Buffer) {
         use splitsum_shaders::kernels::ReadCubeParams;
         let k = &spirv::KERNELS_READ_CUBE;
         let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::Cube), ..Default::default() });
@@ -432,7 +431,7 @@ impl CubeReader {
                 let p = ReadCubeParams { size, level, texel_offset: layout.level_offset(level) };
                 let mut bytes = bytemuck::bytes_of(&p).to_vec();
                 bytes.resize(bytes.len().next_multiple_of(16), 0);
-                let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some("params"), contents: &bytes, usage: wgpu::BufferUsages::UNIFORM });
+                let params = filled(device, queue, "params", &bytes, wgpu::BufferUsages::UNIFORM);
                 let entries: Vec<wgpu::BindGroupEntry> = k
                     .bindings
                     .iter()
@@ -459,6 +458,21 @@ impl CubeReader {
     }
 }
 
+/// A buffer of `usage` holding `data` (a multiple of 4 bytes), written through the queue
+/// rather than mapped at creation: browsers limit buffers mapped at creation (Chromium's
+/// WebGPU on SwiftShader refuses 64 KiB: "createBuffer failed, size (65024) is too large
+/// for the implementation when mappedAtCreation == true").
+pub fn filled(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, data: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: (data.len() as u64).next_multiple_of(wgpu::COPY_BUFFER_ALIGNMENT).max(wgpu::COPY_BUFFER_ALIGNMENT),
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    queue.write_buffer(&buffer, 0, data);
+    buffer
+}
+
 /// The compute pipeline of kernel `k` of `module`, with the bind group layout `layout`.
 fn kernel_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, k: &EntryPoint, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(k.name), bind_group_layouts: &[Some(layout)], immediate_size: 0 });
@@ -474,15 +488,60 @@ fn kernel_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, k: &Entry
 
 /// Waits for `device` and maps `buffer` (created with `MAP_READ`) to read it.
 pub fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
-    let (tx, rx) = std::sync::mpsc::channel();
-    buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-        let _ = tx.send(r);
-    });
+    pollster::block_on(map_read_async(device, buffer))
+}
+
+/// [`map_read`] without blocking: in a browser the mapping completes only when the page's
+/// event loop runs, so it must be awaited there.
+pub async fn map_read_async(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+    let done = Oneshot::default();
+    let sender = done.clone();
+    buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| sender.send(r));
+    // Drives the mapping on native backends; nothing to drive in a browser.
     device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
-    rx.recv().map_err(|e| Error::Gpu(format!("readback: {e}")))?.map_err(|e| Error::Gpu(format!("readback: {e}")))?;
+    done.await.map_err(|e| Error::Gpu(format!("readback: {e}")))?;
     let bytes = buffer.slice(..).get_mapped_range().map_err(|e| Error::Gpu(format!("readback: {e}")))?.to_vec();
     buffer.unmap();
     Ok(bytes)
+}
+
+/// A value sent once from a wgpu callback, awaited.
+struct Oneshot<T>(std::sync::Arc<std::sync::Mutex<(Option<T>, Option<std::task::Waker>)>>);
+
+impl<T> Default for Oneshot<T> {
+    fn default() -> Self {
+        Self(Default::default())
+    }
+}
+
+impl<T> Clone for Oneshot<T> {
+    fn clone(&self) -> Self {
+        Self(self.0.clone())
+    }
+}
+
+impl<T> Oneshot<T> {
+    fn send(&self, v: T) {
+        let mut slot = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        slot.0 = Some(v);
+        if let Some(w) = slot.1.take() {
+            w.wake();
+        }
+    }
+}
+
+impl<T> std::future::Future for Oneshot<T> {
+    type Output = T;
+    fn poll(self: std::pin::Pin<&mut Self>, cx: &mut std::task::Context<'_>) -> std::task::Poll<T> {
+        let mut slot = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        match slot.0.take() {
+            Some(v) => std::task::Poll::Ready(v),
+            None => {
+                slot.1 = Some(cx.waker().clone());
+                std::task::Poll::Pending
+            }
+        }
+    }
 }
 
 /// Texels on the device: `count` RGBA f32 texels in `buffer`.
@@ -737,7 +796,7 @@ impl Kernels for Gpu {
         let dst = self.texels("sh9 rows", n)?;
         let p = IrradianceParams { src_size: src_layout.size, src_levels: src_layout.levels, src_level: level, dst_size: 0, start: 0, count: 0 };
         self.run(&[Dispatch {
-            kernel: &spirv::KERNELS_IRRADIANCE_SH9,
+            kernel: &spirv::KERNELS_IRRADIANCE_SH9_PROJECT,
             params: bytemuck::bytes_of(&p),
             input: Some(&src.buffer),
             output: &dst.buffer,
