@@ -320,3 +320,24 @@ fn a_bake_in_the_browsers_webgpu_matches_the_cpu() {
     eprintln!("WebGPU in Chromium against the CPU: largest relative difference {worst:.2e} ({})", std::fs::read_to_string(out.with_extension("bin.txt")).unwrap_or_default());
     assert!(worst <= 2.0f32.powi(-10), "{worst:.2e}");
 }
+
+/// Settings derive what depends on the size unless given, so any combination of defaults
+/// resolves: 512² faces bake 7 mips from a 512² source, 64² faces 4 mips (down to 8²,
+/// as the command line), an engine target its own count; a value given against the target
+/// is refused by its field.
+#[test]
+fn settings_derive_what_depends_on_the_size() {
+    use splitsum::settings::InputShape;
+    let shape = InputShape::Equirect { width: 1024, height: 512 };
+    let job = |s: Settings| s.resolve(shape, splitsum::Products::ALL).unwrap();
+    let big = job(Settings { size: 512, ..Settings::default() });
+    assert_eq!((big.mips, big.source_size, big.irradiance_source, big.sh_source), (7, 512, 16, 32));
+    let small = job(Settings { size: 64, ..Settings::default() });
+    assert_eq!((small.mips, small.source_size), (4, 64));
+    let tiny = job(Settings { size: 8, ..Settings::default() });
+    assert_eq!((tiny.mips, tiny.irradiance_source, tiny.sh_source), (2, 8, 8));
+    let bevy = job(Settings { size: 64, ..Settings::default() }.with_target(splitsum::Target::Bevy));
+    assert_eq!((bevy.mips, bevy.mapping), (6, splitsum::RoughnessMapping::Linear));
+    let e = Settings { size: 64, mips: Some(4), ..Settings::default() }.with_target(splitsum::Target::Bevy).validate().unwrap_err();
+    assert!(matches!(e, splitsum::Error::Setting { field: splitsum::Field::Mips, .. }), "{e}");
+}
