@@ -61,6 +61,11 @@ ensure_vulkan() {
     ensure_packages '/usr/share/vulkan/icd.d/lvp_icd*.json:mesa-vulkan-drivers' '/usr/lib/*/libvulkan.so.1:libvulkan1'
 }
 
+# Debian's chromium, headless, renders report.html for tests/report.rs.
+ensure_browser() {
+    ensure_packages '/usr/bin/chromium:chromium'
+}
+
 # Mesa's llvmpipe behind EGL runs the GPU tests a second time on wgpu's GL backend.
 ensure_gl() {
     ensure_packages '/usr/lib/*/libEGL.so.1:libegl1' '/usr/lib/*/libEGL_mesa.so.0:libegl-mesa0' '/usr/lib/*/libGLESv2.so.2:libgles2' '/usr/lib/*/dri/swrast_dri.so:libgl1-mesa-dri'
@@ -112,6 +117,7 @@ case "$cmd" in
         ensure_stable
         ensure_vulkan
         ensure_gl
+        ensure_browser
         ensure_test_display
         ensure_peers
         cargo +stable test --release --workspace "$@"
@@ -119,9 +125,8 @@ case "$cmd" in
         # textures on the caller's device, the engine targets and the renderer, held to
         # the same GPU-vs-CPU bounds as on Vulkan.
         echo "dev.sh: the GPU tests on GL (WGPU_BACKEND=gl)" >&2
-        WGPU_BACKEND=gl cargo +stable test --release -p splitsum-tests \
-            --test prefilter --test lut --test equirect --test irradiance --test stability \
-            --test library --test render --test targets "$@"
+        WGPU_BACKEND=gl cargo +stable test --release -p splitsum-tests --test suite "$@" -- \
+            prefilter:: lut:: equirect:: irradiance:: stability:: library:: render:: targets::
         ;;
     peers)
         ensure_peers

@@ -38,7 +38,75 @@ fn no_crate_depends_on_one_above_it() {
     assert!(!dependencies("display").contains("splitsum-reference"), "the references are the report's");
 }
 
-/// Top-level module of each source file of `src`, and the `crate::` modules it names.
+/// The top-level module a `crate::` path names, for every such path in `file`: use trees
+/// (grouped ones too: `use crate::{a, b::c}` names `a` and `b`), paths in code, and paths
+/// inside macro calls (read from their tokens, which syn does not parse).
+fn crate_paths(file: &syn::File) -> BTreeSet<String> {
+    use syn::visit::Visit;
+    #[derive(Default)]
+    struct Names(BTreeSet<String>);
+    fn use_tree(tree: &syn::UseTree, under_crate: bool, out: &mut BTreeSet<String>) {
+        match tree {
+            syn::UseTree::Path(p) if !under_crate => use_tree(&p.tree, p.ident == "crate", out),
+            syn::UseTree::Path(p) => drop(out.insert(p.ident.to_string())),
+            syn::UseTree::Name(n) if under_crate => drop(out.insert(n.ident.to_string())),
+            syn::UseTree::Rename(r) if under_crate => drop(out.insert(r.ident.to_string())),
+            syn::UseTree::Group(g) => g.items.iter().for_each(|t| use_tree(t, under_crate, out)),
+            _ => {}
+        }
+    }
+    impl<'a> Visit<'a> for Names {
+        fn visit_item_use(&mut self, u: &'a syn::ItemUse) {
+            use_tree(&u.tree, false, &mut self.0);
+        }
+        fn visit_path(&mut self, p: &'a syn::Path) {
+            let mut s = p.segments.iter();
+            if let (Some(first), Some(second)) = (s.next(), s.next())
+                && first.ident == "crate"
+            {
+                self.0.insert(second.ident.to_string());
+            }
+            syn::visit::visit_path(self, p);
+        }
+        fn visit_macro(&mut self, m: &'a syn::Macro) {
+            let tokens: Vec<String> = m.tokens.to_string().split_whitespace().map(str::to_string).collect();
+            for w in tokens.windows(3) {
+                if w[0] == "crate" && w[1] == "::" {
+                    self.0.insert(w[2].clone());
+                }
+            }
+            syn::visit::visit_macro(self, m);
+        }
+    }
+    let mut names = Names::default();
+    names.visit_file(file);
+    names.0
+}
+
+/// What the crate root re-exports, by name, and the top-level module each comes from
+/// (`pub use settings::{Job, Settings}` maps `Job` and `Settings` to `settings`), so that
+/// `crate::Settings` counts as an import of `settings`.
+fn root_reexports(lib: &syn::File) -> BTreeMap<String, String> {
+    fn leaves(tree: &syn::UseTree, module: &Option<String>, out: &mut BTreeMap<String, String>) {
+        match tree {
+            syn::UseTree::Path(p) if p.ident == "crate" && module.is_none() => leaves(&p.tree, module, out),
+            syn::UseTree::Path(p) => leaves(&p.tree, &Some(module.clone().unwrap_or_else(|| p.ident.to_string())), out),
+            syn::UseTree::Name(n) => drop(module.as_ref().map(|m| out.insert(n.ident.to_string(), m.clone()))),
+            syn::UseTree::Rename(r) => drop(module.as_ref().map(|m| out.insert(r.rename.to_string(), m.clone()))),
+            syn::UseTree::Group(g) => g.items.iter().for_each(|t| leaves(t, module, out)),
+            syn::UseTree::Glob(_) => {}
+        }
+    }
+    let mut out = BTreeMap::new();
+    for item in &lib.items {
+        if let syn::Item::Use(u) = item {
+            leaves(&u.tree, &None, &mut out);
+        }
+    }
+    out
+}
+
+/// Top-level module of each source file of `src`, and the top-level modules it names.
 fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
     let mut graph: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
     let mut files = vec![];
@@ -53,21 +121,21 @@ fn module_graph(src: &Path) -> BTreeMap<String, BTreeSet<String>> {
             }
         }
     }
+    let top = |f: &Path| f.strip_prefix(src).unwrap().components().next().unwrap().as_os_str().to_string_lossy().trim_end_matches(".rs").to_string();
+    let modules: BTreeSet<String> = files.iter().map(|f| top(f)).collect();
+    let lib = syn::parse_file(&std::fs::read_to_string(src.join("lib.rs")).unwrap()).unwrap();
+    let reexports = root_reexports(&lib);
     for f in &files {
         let rel = f.strip_prefix(src).unwrap();
         let module = rel.components().next().unwrap().as_os_str().to_string_lossy().trim_end_matches(".rs").to_string();
         if module == "lib" {
             continue;
         }
-        // Code only: a doc link is no import.
-        let text: String = std::fs::read_to_string(f).unwrap().lines().filter(|l| !l.trim_start().starts_with("//")).collect::<Vec<_>>().join("\n");
+        let file = syn::parse_file(&std::fs::read_to_string(f).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", f.display()));
         let uses = graph.entry(module.clone()).or_default();
-        for (i, _) in text.match_indices("crate::") {
-            let name: String = text[i + 7..].chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
-            if !name.is_empty() && name != module && name.chars().next().unwrap().is_lowercase() {
-                uses.insert(name);
-            }
-        }
+        // A module, or an item the root re-exports from one; not the crate root's own items.
+        let named = crate_paths(&file).into_iter().filter_map(|n| if modules.contains(&n) { Some(n) } else { reexports.get(&n).cloned() });
+        uses.extend(named.filter(|m| *m != module && modules.contains(m)));
     }
     graph
 }
@@ -105,5 +173,38 @@ fn no_module_of_a_library_crate_imports_in_a_circle() {
         if let Some(c) = cycle(&graph) {
             panic!("{krate}: import circle {}", c.join(" → "));
         }
+    }
+}
+
+#[test]
+fn the_reader_sees_grouped_imports_paths_and_macros() {
+    let file: syn::File = syn::parse_str(
+        "use crate::{alpha, beta::Gamma, delta::{self, x}};\n\
+         use std::fmt;\n\
+         fn f() { crate::epsilon::go(); let _ = format!(\"{}\", crate::zeta::Z); }\n\
+         /// [crate::eta] is a doc link, not an import\n\
+         fn g() {}",
+    )
+    .unwrap();
+    let names: Vec<String> = crate_paths(&file).into_iter().collect();
+    assert_eq!(names, ["alpha", "beta", "delta", "epsilon", "zeta"]);
+    let lib: syn::File = syn::parse_str("pub use crate::settings::{Job, Settings as S};\npub use textures::Baker;\npub use glam;").unwrap();
+    let map = root_reexports(&lib);
+    assert_eq!(map.get("S").map(String::as_str), Some("settings"));
+    assert_eq!(map.get("Job").map(String::as_str), Some("settings"));
+    assert_eq!(map.get("Baker").map(String::as_str), Some("textures"));
+    // And a circle closed through a grouped import is found.
+    let mut graph = BTreeMap::new();
+    graph.insert("a".to_string(), BTreeSet::from(["b".to_string()]));
+    graph.insert("b".to_string(), BTreeSet::from(["a".to_string()]));
+    assert!(cycle(&graph).is_some());
+}
+
+#[test]
+fn the_executors_take_a_job_not_settings_and_settings_know_no_file_format() {
+    let graph = module_graph(&root().join("splitsum").join("src"));
+    for (from, to) in [("backend", "settings"), ("settings", "ktx2"), ("settings", "textures"), ("bake", "ktx2")] {
+        let edges = &graph[from];
+        assert!(!edges.contains(to), "splitsum: {from} imports {to}; it must not (ARCHITECTURE.md)");
     }
 }

@@ -62,12 +62,12 @@ fn the_example_lights_a_sphere_in_a_furnace_as_the_closed_form_says() {
         let material = sphere::Material { albedo: [rho; 3], f0: [1.0; 3], roughness };
         let pic = sphere::draw(d, q, &constant(l), &small(), compute, material, 64).unwrap();
         let centre = pic.pixels[(32 * 64 + 32) as usize];
-        for c in 0..3 {
-            let rel = (centre[c] as f64 - want).abs() / want;
+        for (c, &got) in centre.iter().enumerate().take(3) {
+            let rel = (got as f64 - want).abs() / want;
             if c == 0 {
-                eprintln!("{compute:?}: furnace centre {} against the closed form {want:.5}: {rel:.2e} relative", centre[c]);
+                eprintln!("{compute:?}: furnace centre {got} against the closed form {want:.5}: {rel:.2e} relative");
             }
-            assert!(rel < 1e-2, "{compute:?}: centre channel {c} = {}, the closed form {want:.5} ({rel:.2e})", centre[c]);
+            assert!(rel < 1e-2, "{compute:?}: centre channel {c} = {got}, the closed form {want:.5} ({rel:.2e})");
         }
         assert_eq!(pic.pixels[0][3], 0.0, "{compute:?}: a corner is outside the sphere");
     }

@@ -170,7 +170,7 @@ fn an_embedded_image_without_a_mime_type_is_an_error_not_a_panic() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("no-mime.glb");
     std::fs::write(&path, support::model::glb(&json, bin)).unwrap();
-    let e = splitsum_display::model::load(&path).err().expect("refused").to_string();
+    let e = splitsum_display::model::load(&path).expect_err("refused").to_string();
     assert!(e.contains("no-mime.glb") && e.contains("malformed glTF"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }

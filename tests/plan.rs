@@ -179,9 +179,14 @@ fn the_calibration_reads_a_report() {
     let env = assets().join("environments/studio.exr");
     runner::cli::run(["runner", "report", env.to_str().unwrap(), "--quick", "--backends", "cpu", "--out", dir.to_str().unwrap()]).expect("report");
     let cal = Calibration::from_report_csv(&std::fs::read_to_string(dir.join("report.csv")).unwrap()).expect("a calibration");
-    assert_eq!(cal.lut.iter().map(|r| r.0).collect::<Vec<_>>(), vec![4, 16, 64]);
-    assert!(!cal.prefilter.is_empty() && cal.irradiance.len() == 3);
-    assert!(cal.lut.iter().all(|r| r.1.is_finite() && r.1 > 0.0));
+    // The quick sweep's irradiance sources, and the defaults' three sample counts in every
+    // roughness band, read from their columns.
+    assert_eq!(cal.irradiance.iter().map(|r| r.0).collect::<Vec<_>>(), vec![4, 8, 16]);
+    assert!(cal.irradiance.iter().all(|r| r.1.is_finite() && r.1 > 0.0));
+    assert!(!cal.prefilter.is_empty());
+    for (_, by_samples) in &cal.prefilter {
+        assert_eq!(by_samples.iter().map(|r| r.0).collect::<Vec<_>>(), vec![16, 64, 256]);
+    }
     assert!(Calibration::from_report_csv("product,backend\nnothing,here\n").is_none());
 }
 

@@ -3,43 +3,82 @@
 
 #[test]
 fn quick_report_writes_tables_csv_and_plot() {
+    use splitsum::measured::{Knob, Method, Part, Product, read_csv};
     let dir = std::env::temp_dir().join(format!("splitsum-report-{}", std::process::id()));
     let env = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/studio.exr");
     runner::cli::run(["runner", "report", env, "--quick", "--out", dir.to_str().unwrap()]).expect("report");
-    let csv = std::fs::read_to_string(dir.join("report.csv")).unwrap();
+    let rows = read_csv(&std::fs::read_to_string(dir.join("report.csv")).unwrap()).expect("typed rows");
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    let png = image::open(dir.join("error_vs_time.png")).expect("a PNG").to_rgb8();
-    assert!(png.width() > 500 && png.height() > 300);
-    let rows: Vec<Vec<String>> = csv::Reader::from_reader(csv.as_bytes()).records().map(|r| r.unwrap().iter().map(str::to_string).collect()).collect();
-    for product in ["brdf lut", "prefilter r=0.33", "irradiance (convolution)", "irradiance (SH9)", "shaded colour (n.v >= 0.6)"] {
-        for backend in ["gpu", "cpu"] {
-            assert!(rows.iter().any(|r| r[0] == product && r[1].starts_with(backend)), "no {product} on {backend}");
-        }
-        assert!(md.contains(&format!("## {product}")), "{product} missing from report.md");
+    let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
+    let svg = std::fs::read_to_string(dir.join("error_vs_time.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("mean relative error") && svg.contains("bake time (ms)"));
+    for file in ["surface_splitsum.png", "surface_exact.png", "surface_error.png"] {
+        let png = image::open(dir.join(file)).expect("a PNG").to_rgb8();
+        assert!(png.width() > 200 && png.height() > 50, "{file}");
+        assert!(html.contains(file) && md.contains(file), "{file} is on the page");
     }
-    assert!(rows.iter().any(|r| r[0].contains("split-sum approximation")));
-    // The end-to-end measure: every method on both backends, decomposed by band.
-    for product in ["shaded colour, end to end", "prefiltered lookup, any roughness"] {
+    for (product, method) in [
+        (Product::BrdfTable, Method::Seed),
+        (Product::BrdfTable, Method::Defaults),
+        (Product::Prefilter, Method::Defaults),
+        (Product::Irradiance, Method::Defaults),
+        (Product::Irradiance, Method::Sh9),
+        (Product::ShadedColour, Method::Defaults),
+        (Product::ShadedColour, Method::Seed),
+        (Product::PrefilteredLookup, Method::Seed),
+        (Product::PrefilteredLookup, Method::Defaults),
+    ] {
         for backend in ["gpu", "cpu"] {
-            for method in ["seed", "defaults"] {
-                assert!(
-                    rows.iter().any(|r| r[0].starts_with(product) && r[1].starts_with(backend) && r[2].starts_with(method)),
-                    "no {product} of {method} on {backend}"
-                );
-            }
+            assert!(rows.iter().any(|r| r.product == product && r.method == method && r.backend == backend), "no {product:?} by {method:?} on {backend}");
         }
+        assert!(md.contains(&format!("## {}", product.title())) && html.contains(&format!("<h2>{}</h2>", product.title())), "{product:?}");
+        // Every product is a panel of the figure.
+        assert!(svg.contains(product.title()), "{product:?} has no panel");
     }
-    assert!(rows.iter().any(|r| r[0].ends_with("(b) split sum")) && rows.iter().any(|r| r[0].ends_with("(c) model")));
+    assert!(rows.iter().any(|r| r.method == Method::ExactIngredients && r.part == Part::SplitSum));
+    assert!(rows.iter().any(|r| r.part == Part::SplitSum && r.backend == "gpu") && rows.iter().any(|r| r.part == Part::Model));
     for r in &rows {
-        let mean: f64 = r[4].parse().unwrap();
-        assert!(mean.is_finite() && mean >= 0.0, "{r:?}");
+        assert!(r.mean_error.is_finite() && r.mean_error >= 0.0 && r.max_error >= r.mean_error, "{r:?}");
     }
     // The table's error falls with its sample count (4 → 64) on both backends.
     for backend in ["gpu", "cpu"] {
-        let errs: Vec<f64> = rows.iter().filter(|r| r[0] == "brdf lut" && r[1].starts_with(backend)).map(|r| r[4].parse().unwrap()).collect();
-        assert!(errs.first() > errs.last(), "{backend}: {errs:?}");
+        let errs: Vec<f64> =
+            rows.iter().filter(|r| r.product == Product::BrdfTable && r.knob == Knob::Samples && r.backend == backend).map(|r| r.mean_error).collect();
+        assert_eq!(errs.len(), 3);
+        assert!(errs[0] > errs[2], "{backend}: {errs:?}");
     }
     assert!(md.contains("Best error per millisecond"));
+}
+
+/// `report.html` in a real browser (Debian's chromium, headless): the page loads with its
+/// figures (an image that fails to load is drawn as a small broken-image icon, so the
+/// page's laid-out height tells), and the screenshot is kept beside the report.
+#[test]
+fn the_report_page_renders_in_a_browser() {
+    let Some(chromium) = ["chromium", "chromium-browser"].into_iter().find(|c| std::process::Command::new(c).arg("--version").output().is_ok_and(|o| o.status.success())) else {
+        panic!("chromium is needed (dev.sh test installs it)");
+    };
+    let dir = std::env::temp_dir().join(format!("splitsum-report-page-{}", std::process::id()));
+    let env = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/studio.exr");
+    runner::cli::run(["runner", "report", env, "--quick", "--backends", "cpu", "--out", dir.to_str().unwrap()]).expect("report");
+    let shot = std::env::temp_dir().join(format!("splitsum-report-page-{}.png", std::process::id()));
+    let profile = std::env::temp_dir().join(format!("splitsum-chromium-{}", std::process::id()));
+    let out = std::process::Command::new(chromium)
+        .args(["--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--window-size=1200,1600"])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(format!("file://{}", dir.join("report.html").display()))
+        .output()
+        .expect("chromium runs");
+    assert!(shot.exists(), "no screenshot: {}", String::from_utf8_lossy(&out.stderr));
+    let img = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!((img.width(), img.height()), (1200, 1600));
+    // The figure: the methods' colours (the seed's orange, the defaults' blue; `plot.rs`)
+    // drawn in the top of the page, where the small multiples sit.
+    let has = |c: [u8; 3]| img.pixels().any(|p| p.0.iter().zip(c).all(|(a, b)| a.abs_diff(b) < 12));
+    assert!(has([213, 94, 0]) && has([0, 114, 178]), "the figure's series are not on the page");
+    let _ = std::fs::remove_dir_all(&profile);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The end-to-end measure on a constant sky, where the prefiltered and irradiance products
@@ -54,20 +93,21 @@ fn end_to_end_measure_of_a_constant_sky() {
     use splitsum::environment::Environment;
     use splitsum::settings::Settings;
     use splitsum::texture::Equirect;
+    use splitsum::measured::{Part, Product};
     use splitsum_report::accuracy::{Method, Points};
     use splitsum_shaders::glam::Vec4;
     let env = Environment::Equirect(Equirect { width: 64, height: 32, texels: vec![Vec4::new(0.5, 1.0, 2.0, 1.0); 64 * 32] });
     let settings = Settings { size: 16, source_size: Some(16), ..Settings::default() };
     let source = splitsum::bake::host_source_cube(&splitsum::Backend::Cpu, &env, &settings).unwrap();
     let points = Points::new(&source, 48, 32);
-    let methods = [Method { label: "defaults".into(), family: "defaults", settings, flags: splitsum_shaders::shade::ShadeOptions::DEFAULT.flags }];
+    let methods = [Method { kind: splitsum::measured::Method::Defaults, settings, flags: splitsum_shaders::shade::ShadeOptions::DEFAULT.flags }];
     let rows = splitsum_report::accuracy::measure(&splitsum::Backend::Cpu, &env, &methods, &points).unwrap();
-    let worst = |pred: &dyn Fn(&str) -> bool| rows.iter().filter(|r| pred(&r.product)).map(|r| r.max_error).fold(0.0f64, f64::max);
-    let bake = worst(&|p| p.ends_with("(a) bake"));
-    let lookup = worst(&|p| p.starts_with("prefiltered lookup"));
-    let split = worst(&|p| p.ends_with("(b) split sum"));
+    let worst = |product: Product, part: Part| rows.iter().filter(|r| r.product == product && r.part == part).map(|r| r.max_error).fold(0.0f64, f64::max);
+    let bake = worst(Product::ShadedColour, Part::Bake);
+    let lookup = worst(Product::PrefilteredLookup, Part::Total);
+    let split = worst(Product::ShadedColour, Part::SplitSum);
     println!("constant sky: bake share max {bake:.2e}, lookup max {lookup:.2e}, split sum max {split:.2e}");
     assert!(bake < 5e-3 && lookup < 1e-5, "bake {bake:e}, lookup {lookup:e}");
     assert!(split.is_finite() && split > 0.0);
-    assert!(rows.iter().any(|r| r.product.starts_with("shaded colour, end to end") && r.time_ms.is_finite()));
+    assert!(rows.iter().any(|r| r.product == Product::ShadedColour && r.time_ms.is_some_and(f64::is_finite)));
 }

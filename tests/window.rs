@@ -82,7 +82,8 @@ fn the_viewer_window_shows_the_scene() {
     let (w, h) = (320u32, 200u32);
     let state = ViewState { exposure: baked.auto_exposure(), ..ViewState::default() };
 
-    let shot: Arc<Mutex<Option<(u32, u32, Vec<[u8; 3]>)>>> = Arc::default();
+    type Shot = Option<(u32, u32, Vec<[u8; 3]>)>;
+    let shot: Arc<Mutex<Shot>> = Arc::default();
     let sink = shot.clone();
     let shot_display = display.clone();
     let options = splitsum_display::view::ViewOptions {

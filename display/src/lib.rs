@@ -8,6 +8,7 @@
 //!
 //! Depends on `splitsum` (the bake) and nothing above it.
 
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
 #![warn(missing_docs)]
 
 pub mod model;

@@ -390,7 +390,7 @@ fn primitive(
     let positions = g.positions;
     let n = positions.len();
     let indices: Vec<u32> = g.indices.unwrap_or_else(|| (0..n as u32).collect());
-    if indices.iter().any(|&i| i as usize >= n) || indices.len() % 3 != 0 {
+    if indices.iter().any(|&i| i as usize >= n) || !indices.len().is_multiple_of(3) {
         return Err(Error::file(path, "a primitive has indices out of range or not a whole number of triangles"));
     }
     let per_vertex = |name: &str, len: usize| -> Result<()> {

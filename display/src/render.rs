@@ -221,7 +221,7 @@ impl GpuScene {
         let specular = gpu.upload_bytes("specular", bytemuck::cast_slice(&env.specular.texels));
         let irradiance = gpu.upload_bytes("irradiance", bytemuck::cast_slice(&env.irradiance.texels));
         let lut = gpu.upload_bytes("brdf lut", bytemuck::cast_slice(&env.lut.texels));
-        let source = gpu.upload_bytes("source", bytemuck::cast_slice(&env.source.level(0)));
+        let source = gpu.upload_bytes("source", bytemuck::cast_slice(env.source.level(0)));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,

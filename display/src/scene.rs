@@ -380,11 +380,10 @@ impl Scene {
         let bad = |m: String| Err(Error::Invalid(m));
         for m in &self.materials {
             for (what, p) in [("metallic", &m.metallic), ("roughness", &m.roughness)] {
-                if let Param::Texture(t) = p {
-                    if t != "texture" {
+                if let Param::Texture(t) = p
+                    && t != "texture" {
                         return bad(format!("material {:?}: {what} must be a number, [a, b] or \"texture\", not {t:?}", m.name));
                     }
-                }
                 let (a, b) = p.range();
                 if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a > b {
                     return bad(format!("material {:?}: {what} range [{a}, {b}] must lie in [0, 1] with a ≤ b", m.name));
@@ -402,11 +401,10 @@ impl Scene {
         if !(self.camera.fov > 1.0 && self.camera.fov < 170.0) {
             return bad(format!("[camera] fov must be between 1 and 170 degrees, not {}", self.camera.fov));
         }
-        if let Some(e) = self.quality.max_error {
-            if !(e > 0.0) {
+        if let Some(e) = self.quality.max_error
+            && !(e > 0.0) {
                 return bad(format!("[quality] max_error must be positive, not {e}"));
             }
-        }
         // The [quality] fields that are bake settings go through the one validation,
         // `Settings::validate`, which names them as the scene does.
         let q = &self.quality;

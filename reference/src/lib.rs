@@ -7,6 +7,7 @@
 //! quadrature or exact sums instead of Hammersley sampling. The only thing shared with the
 //! code under test is the data: texel values of a cube, read as `glam::Vec4`.
 
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
 pub mod quadrature;
 
 use crate::quadrature::adaptive;

@@ -24,7 +24,7 @@
 //! - (c) *model*: the full integral with the method's masking term against the truth
 //!   (Smith–Schlick against exact Smith).
 
-use crate::measurement::{Measurement, REL, arr, rel, rel64};
+use crate::measurement::{Knob, Measurement, Method as Kind, Metric, Part, Product, arr, rel, rel64};
 use rayon::prelude::*;
 use splitsum::backend::Backend;
 use splitsum::bake;
@@ -45,28 +45,24 @@ pub const ROUGHNESS_BANDS: [f32; 7] = [0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75];
 /// `n·v` bands (upper bounds; the first starts at 0).
 pub const VIEW_BANDS: [f32; 4] = [0.1, 0.3, 0.6, 1.0];
 
-/// Label of the roughness band holding `r`.
-fn roughness_band(r: f32) -> String {
+/// The roughness band `[lo, hi)` holding `r` (the last band ends at 1, inclusive).
+fn roughness_band(r: f32) -> (f32, f32) {
     let i = ROUGHNESS_BANDS.iter().rposition(|&lo| r >= lo).unwrap_or(0);
-    let hi = ROUGHNESS_BANDS.get(i + 1).copied().unwrap_or(1.0);
-    format!("r in [{}, {}{}", ROUGHNESS_BANDS[i], hi, if i + 1 == ROUGHNESS_BANDS.len() { "]" } else { ")" })
+    (ROUGHNESS_BANDS[i], ROUGHNESS_BANDS.get(i + 1).copied().unwrap_or(1.0))
 }
 
-/// Label of the `n·v` band holding `nv`.
-fn view_band(nv: f32) -> String {
+/// The `n·v` band `(lo, hi]` holding `nv`.
+fn view_band(nv: f32) -> (f32, f32) {
     let i = VIEW_BANDS.iter().position(|&hi| nv <= hi).unwrap_or(VIEW_BANDS.len() - 1);
-    let lo = if i == 0 { 0.0 } else { VIEW_BANDS[i - 1] };
-    format!("n.v in ({lo}, {}]", VIEW_BANDS[i])
+    (if i == 0 { 0.0 } else { VIEW_BANDS[i - 1] }, VIEW_BANDS[i])
 }
 
 /// A display method: bake settings and shading flags.
 #[derive(Clone, Debug)]
 pub struct Method {
-    /// Its name in the report.
-    pub label: String,
-    /// The curve it belongs to on the error-against-time plot (methods that differ only in
-    /// a knob such as the sample count share one).
-    pub family: &'static str,
+    /// Which method (its colour on the plots; methods that differ only in the sample
+    /// count share one, told apart by `settings.samples`).
+    pub kind: Kind,
     /// How it bakes.
     pub settings: Settings,
     /// `ShadeOptions::flags` of its image-based light (`IBL` and options).
@@ -246,9 +242,17 @@ pub fn seed_settings(source_size: u32) -> Settings {
     }
 }
 
+/// One shading point's errors: roughness, `n·v`, then against the truth, and the
+/// bake's, the split sum's and the model's shares.
+struct PointErrors {
+    roughness: f32,
+    n_dot_v: f32,
+    parts: [(Part, f64); 4],
+}
+
 /// Bakes each method on `backend`, times it and measures it at `points`.
 pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points: &Points) -> Result<Vec<Measurement>> {
-    let b = backend.describe();
+    let (engine, device) = (if backend.is_gpu() { "gpu" } else { "cpu" }, backend.describe());
     let mut rows = Vec::new();
     for method in methods {
         let start = Instant::now();
@@ -258,8 +262,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
         let opts = method.options();
         let dominant = usize::from(opts.flags & ShadeOptions::DOMINANT_DIRECTION != 0);
         let correlated = usize::from(method.settings.lut_masking.unwrap_or(method.settings.lut_method.default_masking()) == Masking::SmithCorrelated);
-        // Per point: (r, n·v, total error, (a), (b), (c)).
-        let per_point: Vec<(f32, f32, f64, f64, f64, f64)> = points
+        let per_point: Vec<PointErrors> = points
             .shading
             .iter()
             .map(|p| {
@@ -269,28 +272,44 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
                 let exact = IblSample { prefiltered: vec(p.prefiltered[dominant]), irradiance: vec(p.irradiance), brdf: p.table[correlated] };
                 let split = shade::ibl(opts, m, p.n, p.v, exact);
                 let full = if correlated == 1 { p.truth } else { p.full_schlick };
-                (m.roughness, p.n.dot(p.v), rel(shown, p.truth), rel(shown, arr(split)), rel(split, full), rel64(full, p.truth))
+                PointErrors {
+                    roughness: m.roughness,
+                    n_dot_v: p.n.dot(p.v),
+                    parts: [
+                        (Part::Total, rel(shown, p.truth)),
+                        (Part::Bake, rel(shown, arr(split))),
+                        (Part::SplitSum, rel(split, full)),
+                        (Part::Model, rel64(full, p.truth)),
+                    ],
+                }
             })
             .collect();
-        let label = &method.label;
-        let all: Vec<f64> = per_point.iter().map(|p| p.2).collect();
-        rows.push(Measurement::of(format!("shaded colour, end to end: {}", method.family), &b, label.clone(), ms, &all, REL));
-        let mut bands: Vec<(String, Vec<&(f32, f32, f64, f64, f64, f64)>)> = Vec::new();
-        for p in &per_point {
-            for key in [roughness_band(p.0), view_band(p.1)] {
-                match bands.iter_mut().find(|(k, _)| *k == key) {
-                    Some((_, v)) => v.push(p),
-                    None => bands.push((key, vec![p])),
-                }
-            }
+        let row = |product: Product, errors: &[f64]| Measurement {
+            backend: engine.into(),
+            device: device.clone(),
+            samples: Some(method.settings.samples),
+            knob: Knob::Samples,
+            ..Measurement::of(product, method.kind, errors, Metric::RelativeLuminance)
+        };
+        let all: Vec<f64> = per_point.iter().map(|p| p.parts[0].1).collect();
+        rows.push(Measurement { time_ms: Some(ms), ..row(Product::ShadedColour, &all) });
+        // By roughness band, then by view band, each split into its parts.
+        let mut roughness: Vec<(f32, f32)> = per_point.iter().map(|p| roughness_band(p.roughness)).collect();
+        let mut views: Vec<(f32, f32)> = per_point.iter().map(|p| view_band(p.n_dot_v)).collect();
+        for v in [&mut roughness, &mut views] {
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            v.dedup();
         }
-        bands.sort_by(|a, b| a.0.cmp(&b.0));
-        for (key, pts) in &bands {
-            let col = |f: fn(&(f32, f32, f64, f64, f64, f64)) -> f64| pts.iter().map(|p| f(p)).collect::<Vec<f64>>();
-            rows.push(Measurement::of(format!("shaded colour {key}"), &b, label.clone(), f64::NAN, &col(|p| p.2), REL));
-            rows.push(Measurement::of(format!("shaded colour {key}: (a) bake"), &b, label.clone(), f64::NAN, &col(|p| p.3), REL));
-            rows.push(Measurement::of(format!("shaded colour {key}: (b) split sum"), &b, label.clone(), f64::NAN, &col(|p| p.4), REL));
-            rows.push(Measurement::of(format!("shaded colour {key}: (c) model"), &b, label.clone(), f64::NAN, &col(|p| p.5), REL));
+        for k in 0..4 {
+            let part = per_point[0].parts[k].0;
+            for &(lo, hi) in &roughness {
+                let e: Vec<f64> = per_point.iter().filter(|p| roughness_band(p.roughness) == (lo, hi)).map(|p| p.parts[k].1).collect();
+                rows.push(Measurement { part, roughness_lo: Some(lo), roughness_hi: Some(hi), ..row(Product::ShadedColour, &e) });
+            }
+            for &(lo, hi) in &views {
+                let e: Vec<f64> = per_point.iter().filter(|p| view_band(p.n_dot_v) == (lo, hi)).map(|p| p.parts[k].1).collect();
+                rows.push(Measurement { part, nv_lo: Some(lo), nv_hi: Some(hi), ..row(Product::ShadedColour, &e) });
+            }
         }
         // The prefiltered radiance a renderer reads at any roughness.
         let lookups: Vec<(f32, bool, f64)> = points
@@ -302,13 +321,18 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             })
             .collect();
         let all: Vec<f64> = lookups.iter().map(|l| l.2).collect();
-        rows.push(Measurement::of(format!("prefiltered lookup, any roughness: {}", method.family), &b, label.clone(), ms, &all, REL));
+        rows.push(Measurement { time_ms: Some(ms), ..row(Product::PrefilteredLookup, &all) });
         for &lo in &ROUGHNESS_BANDS {
             let band = roughness_band(lo);
-            for (near, place) in [(true, "near the sun"), (false, "anywhere")] {
+            for near in [true, false] {
                 let e: Vec<f64> = lookups.iter().filter(|l| l.1 == near && roughness_band(l.0) == band).map(|l| l.2).collect();
                 if !e.is_empty() {
-                    rows.push(Measurement::of(format!("prefiltered lookup {band} {place}"), &b, label.clone(), f64::NAN, &e, REL));
+                    rows.push(Measurement {
+                        roughness_lo: Some(band.0),
+                        roughness_hi: Some(band.1),
+                        near_sun: Some(near),
+                        ..row(Product::PrefilteredLookup, &e)
+                    });
                 }
             }
         }

@@ -11,11 +11,12 @@
 //! irradiance and table), which isolates the error of the split-sum approximation itself
 //! (n = v = r, and the split) from the sampling and filtering error of the bake.
 //!
-//! Outputs: `report.md` (tables), `report.csv`, `error_vs_time.png` (log–log, one curve
-//! per product and backend).
+//! Outputs: `report.html` (every figure and table), `report.md` (the same, for a
+//! repository), `report.csv` (the typed rows, `splitsum::measured`), `error_vs_time.svg`
+//! (small multiples, [`crate::plot`]) and the error on surfaces ([`crate::surface`]).
 
-use crate::measurement::{ABS, Measurement, REL, arr, rel};
-use crate::plot::{self, Series};
+use crate::measurement::{Knob, Measurement, Method, Metric, Part, Product, arr, rel};
+use crate::surface::ErrorMap;
 use rayon::prelude::*;
 use splitsum::backend::Backend;
 use splitsum::bake;
@@ -63,8 +64,8 @@ pub struct Sweep {
     pub irradiance_size: u32,
     /// Source levels swept for SH9.
     pub sh_sources: Vec<u32>,
-    /// Quality levels of the shaded colour: (label, settings).
-    pub qualities: Vec<(String, Settings)>,
+    /// Quality levels of the shaded colour.
+    pub qualities: Vec<Settings>,
     /// Probe directions per comparison.
     pub directions: u32,
     /// Largest face size of the source cube of the end-to-end measure (`accuracy`): the
@@ -90,7 +91,7 @@ impl Sweep {
             vec![8, 16, 32, 64, 128],
             32,
         );
-        sweep.qualities.push(("defaults (bake's)".to_string(), Settings::default()));
+        sweep.qualities.push(Settings::default());
         sweep
     }
 
@@ -106,6 +107,7 @@ impl Sweep {
     /// face size is `native`: the seed method, today's defaults, and each shading option.
     pub fn methods(&self, native: u32) -> Vec<crate::accuracy::Method> {
         use crate::accuracy::{Method, seed_settings};
+        use crate::measurement::Method as Kind;
         let src = native.min(self.accuracy_source).max(4);
         let default = Settings { size: src, source_size: Some(src), ..Settings::default() };
         let flags = ShadeOptions::DEFAULT.flags & !(ShadeOptions::IBL | ShadeOptions::DIRECT);
@@ -113,33 +115,17 @@ impl Sweep {
         // Each method's error against its bake time: the seed at three sample counts, the
         // defaults at three (mip 1's count; ×2 per mip after it).
         for n in [64, 256, 1024] {
-            let label = if n == 1024 { "seed (6 linear mips, 1024 samples, sampled table)".to_string() } else { format!("seed, {n} samples") };
-            methods.push(Method { label, family: "seed method", settings: Settings { samples: n, ..seed_settings(src) }, flags: 0 });
+            methods.push(Method { kind: Kind::Seed, settings: Settings { samples: n, ..seed_settings(src) }, flags: 0 });
         }
         for n in [16, 256] {
-            methods.push(Method { label: format!("defaults, {n} samples"), family: "defaults", settings: Settings { samples: n, ..default.clone() }, flags });
+            methods.push(Method { kind: Kind::Defaults, settings: Settings { samples: n, ..default.clone() }, flags });
         }
         methods.extend(vec![
-            Method { label: "defaults".into(), family: "defaults", settings: default.clone(), flags },
-            Method {
-                label: "defaults, mirror direction".into(),
-                family: "options",
-                settings: default.clone(),
-                flags: flags & !ShadeOptions::DOMINANT_DIRECTION,
-            },
-            Method { label: "defaults + multiple scattering".into(), family: "options", settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
-            Method {
-                label: "defaults + filtered sampling".into(),
-                family: "options",
-                settings: default.clone(),
-                flags: flags | ShadeOptions::FILTERED_SAMPLING,
-            },
-            Method {
-                label: "defaults, Smith-Schlick table".into(),
-                family: "options",
-                settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default },
-                flags,
-            },
+            Method { kind: Kind::Defaults, settings: default.clone(), flags },
+            Method { kind: Kind::MirrorDirection, settings: default.clone(), flags: flags & !ShadeOptions::DOMINANT_DIRECTION },
+            Method { kind: Kind::MultipleScattering, settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
+            Method { kind: Kind::FilteredSampling, settings: default.clone(), flags: flags | ShadeOptions::FILTERED_SAMPLING },
+            Method { kind: Kind::SmithSchlickTable, settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default }, flags },
         ]);
         methods
     }
@@ -158,8 +144,7 @@ impl Sweep {
         directions: u32,
     ) -> Self {
         let mips = 4;
-        let level = |label: &str, n: u32, lut: u32, irr: u32| {
-            let s = Settings {
+        let level = |n: u32, lut: u32, irr: u32| Settings {
                 size: specular_size,
                 source_size: Some(source_size),
                 mips: Some(mips),
@@ -170,19 +155,12 @@ impl Sweep {
                 lut_size: lut,
                 lut_samples: n,
                 ..Settings::default()
-            };
-            (label.to_string(), s)
         };
         let q = &samples;
         let qualities = vec![
-            level(&format!("q1 ({} samples)", q[0]), q[0], lut_sizes[0], irradiance_sources[0]),
-            level(
-                &format!("q2 ({} samples)", q[q.len() / 2]),
-                q[q.len() / 2],
-                lut_sizes[lut_sizes.len() / 2],
-                irradiance_sources[irradiance_sources.len() / 2],
-            ),
-            level(&format!("q3 ({} samples)", q[q.len() - 1]), q[q.len() - 1], *lut_sizes.last().expect("sizes"), *irradiance_sources.last().expect("sizes")),
+            level(q[0], lut_sizes[0], irradiance_sources[0]),
+            level(q[q.len() / 2], lut_sizes[lut_sizes.len() / 2], irradiance_sources[irradiance_sources.len() / 2]),
+            level(q[q.len() - 1], *lut_sizes.last().expect("sizes"), *irradiance_sources.last().expect("sizes")),
         ];
         Self {
             source_size,
@@ -231,11 +209,11 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
     let mut rows = Vec::new();
     rows.extend(refs.split_error_rows());
     for backend in backends {
-        let b = backend.describe();
-        let _step = splitsum::progress::step(&format!("report: every product on {b}"), None);
+        let b = Device { engine: if backend.is_gpu() { "gpu" } else { "cpu" }, description: backend.describe() };
+        let _step = splitsum::progress::step(&format!("report: every product on {}", b.description), None);
         // Warm-up, outside the timings: first dispatches pay for driver set-up and caches.
         backend.brdf_lut(4, 4)?;
-        backend.brdf_table(4, splitsum_shaders::brdf::microfacet::Masking::SmithSchlick)?;
+        backend.brdf_table(4, Masking::SmithSchlick)?;
         backend.prefilter(&source, CubeLayout::new(4, 1), &[0.5], 4, 0.0)?;
         backend.irradiance(&source, source.layout.levels - 1, 4)?;
         rows.extend(lut_rows(backend, &b, sweep, &refs)?);
@@ -258,8 +236,16 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
         let _step = splitsum::progress::step(&format!("report: end to end on {}", backend.describe()), None);
         rows.extend(crate::accuracy::measure(backend, env, &methods, &points)?);
     }
-    let _step = splitsum::progress::step("report: writing report.md, report.csv, error_vs_time.png", None);
-    write_outputs(dir, name, backends, sweep, &rows)?;
+    // The error on surfaces: the defaults' sphere grid against the exact integral.
+    let map = {
+        let _step = splitsum::progress::step("report: error on surfaces (f64 sphere grid)", None);
+        let defaults = methods.iter().find(|m| m.kind == crate::measurement::Method::Defaults && m.settings.samples == Settings::default().samples);
+        let baked = bake::bake_for_display(&backends[0], env, &defaults.unwrap_or(&methods[0]).settings)?;
+        let exact = reference::Environment::new(acc_source.level(0), acc_source.layout.size);
+        crate::surface::error_map(&baked, &exact)
+    };
+    let _step = splitsum::progress::step("report: writing report.html, report.md, report.csv and the figures", None);
+    write_outputs(dir, name, backends, sweep, &rows, &map)?;
     Ok(rows)
 }
 
@@ -274,13 +260,27 @@ struct References {
     shading: Vec<ShadingPoint>,
 }
 
-/// The view-angle classes the shaded colour is reported in: near normal and grazing, where
-/// the split sum's `n = v = r` assumption is known to fail.
-const VIEWS: [(&str, f32, f32); 2] = [("(n.v >= 0.6)", 0.59, 1.01), ("(n.v = 0.25)", 0.0, 0.3)];
+/// The view-angle classes `(lo, hi]` the shaded colour of the quality levels is reported
+/// in: near normal and grazing, where the split sum's `n = v = r` assumption is known to
+/// fail. The points sit at `n·v` 0.95, 0.6 and 0.25.
+const VIEWS: [(f32, f32); 2] = [(0.59, 1.0), (0.0, 0.3)];
 
-fn in_view(p: &ShadingPoint, lo: f32, hi: f32) -> bool {
+fn in_view(p: &ShadingPoint, (lo, hi): (f32, f32)) -> bool {
     let nv = p.n.dot(p.v);
-    nv >= lo && nv < hi
+    nv > lo && nv <= hi + 1e-3
+}
+
+/// The backend a row was measured on: `gpu` or `cpu`, and its description.
+struct Device {
+    engine: &'static str,
+    description: String,
+}
+
+impl Device {
+    /// A row of `product` by `method` on this device.
+    fn row(&self, product: Product, method: Method, errors: &[f64], metric: Metric) -> Measurement {
+        Measurement { backend: self.engine.into(), device: self.description.clone(), ..Measurement::of(product, method, errors, metric) }
+    }
 }
 
 struct ShadingPoint {
@@ -349,38 +349,62 @@ impl References {
     fn split_error_rows(&self) -> Vec<Measurement> {
         VIEWS
             .iter()
-            .map(|&(label, lo, hi)| {
-                let errors: Vec<f64> = self.shading.iter().filter(|p| in_view(p, lo, hi)).map(|p| rel(p.exact_split, p.full)).collect();
-                Measurement::of(format!("shaded colour {label}: split-sum approximation"), "exact ingredients", "n = v = r, split", f64::NAN, &errors, REL)
+            .map(|&(lo, hi)| {
+                let errors: Vec<f64> = self.shading.iter().filter(|p| in_view(p, (lo, hi))).map(|p| rel(p.exact_split, p.full)).collect();
+                let row = Measurement::of(Product::ShadedColour, Method::ExactIngredients, &errors, Metric::RelativeLuminance);
+                Measurement { part: Part::SplitSum, nv_lo: Some(lo), nv_hi: Some(hi), ..row }
             })
             .collect()
     }
 }
 
-fn lut_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References) -> Result<Vec<Measurement>> {
+/// The table's error at each texel: the relative error of the directional albedo
+/// `F₀·A + B` it gives, the larger of a dielectric's (`F₀ = 0.04`) and a white metal's.
+fn albedo_errors(got: impl Iterator<Item = Vec2>, want: impl Iterator<Item = Vec2>) -> Vec<f64> {
+    got.zip(want)
+        .map(|(g, r)| {
+            [0.04f64, 1.0]
+                .iter()
+                .map(|&f0| {
+                    let (eg, er) = (f0 * g.x as f64 + g.y as f64, f0 * r.x as f64 + r.y as f64);
+                    (eg - er).abs() / er.max(1e-6)
+                })
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
+fn lut_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
+    let size = Some(sweep.lut_size);
     for &n in &sweep.samples {
         let (table, ms) = timed(|| backend.brdf_lut(sweep.lut_size, n))?;
-        let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
-        rows.push(Measurement::of("brdf lut", b, format!("{n} samples"), ms, &errors, ABS));
+        let errors = albedo_errors(table.texels.iter().copied(), refs.lut.iter().copied());
+        rows.push(Measurement { knob: Knob::Samples, samples: Some(n), size, time_ms: Some(ms), ..b.row(Product::BrdfTable, Method::Seed, &errors, Metric::RelativeAlbedo) });
     }
     // The deterministic quadrature (the default table), on the same texels.
-    let (table, ms) = timed(|| backend.brdf_table(sweep.lut_size, splitsum_shaders::brdf::microfacet::Masking::SmithSchlick))?;
-    let errors: Vec<f64> = table.texels.iter().zip(&refs.lut).map(|(g, r)| (*g - *r).abs().max_element() as f64).collect();
-    rows.push(Measurement::of("brdf lut (quadrature)", b, format!("{0}x{0}", sweep.lut_size), ms, &errors, ABS));
+    let (table, ms) = timed(|| backend.brdf_table(sweep.lut_size, Masking::SmithSchlick))?;
+    let errors = albedo_errors(table.texels.iter().copied(), refs.lut.iter().copied());
+    rows.push(Measurement { size, time_ms: Some(ms), ..b.row(Product::BrdfTable, Method::Defaults, &errors, Metric::RelativeAlbedo) });
     let n = *sweep.samples.last().expect("samples");
     for &size in &sweep.lut_sizes {
         let (table, ms) = timed(|| backend.brdf_lut(size, n))?;
-        let errors: Vec<f64> = refs.lut_points.iter().map(|(p, r)| (lut::sample(&table.texels, size, p.x, p.y) - *r).abs().max_element() as f64).collect();
-        rows.push(Measurement::of("brdf lut lookup", b, format!("{size}x{size} at {n} samples"), ms, &errors, ABS));
+        let errors = albedo_errors(refs.lut_points.iter().map(|(p, _)| lut::sample(&table.texels, size, p.x, p.y)), refs.lut_points.iter().map(|(_, r)| *r));
+        rows.push(Measurement {
+            knob: Knob::Size,
+            samples: Some(n),
+            size: Some(size),
+            time_ms: Some(ms),
+            ..b.row(Product::BrdfTableLookup, Method::Seed, &errors, Metric::RelativeAlbedo)
+        });
     }
     Ok(rows)
 }
 
-fn prefilter_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
+fn prefilter_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
     let roughness: Vec<f32> = (0..sweep.mips).map(|m| RoughnessMapping::Linear.roughness(m, sweep.mips)).collect();
-    let mut level = |n: u32, bias: f32, m: usize, size: u32, product: String, setting: String| -> Result<()> {
+    let mut level = |n: u32, bias: f32, m: usize, size: u32, knob: Knob| -> Result<()> {
         let layout = CubeLayout::new(size, 1);
         let (cube, ms) = timed(|| backend.prefilter(source, layout, &[roughness[m]], n, bias))?;
         let errors: Vec<f64> = refs
@@ -389,29 +413,31 @@ fn prefilter_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, 
             .zip(&refs.prefilter[m])
             .map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, layout, 0, d).truncate(), *r))
             .collect();
-        rows.push(Measurement::of(product, b, setting, ms, &errors, REL));
+        let row = b.row(Product::Prefilter, Method::Defaults, &errors, Metric::RelativeLuminance);
+        let r = Some(roughness[m]);
+        rows.push(Measurement { knob, samples: Some(n), bias: Some(bias), size: Some(size), roughness_lo: r, roughness_hi: r, time_ms: Some(ms), ..row });
         Ok(())
     };
     let default_bias = Settings::default().lod_bias;
-    for m in 1..sweep.mips as usize {
+    for (m, _) in roughness.iter().enumerate().skip(1) {
         let size = (sweep.specular_size >> m).max(1);
         for &n in &sweep.samples {
-            level(n, default_bias, m, size, format!("prefilter r={:.2}", roughness[m]), format!("{n} samples, bias {default_bias}"))?;
+            level(n, default_bias, m, size, Knob::Samples)?;
         }
         for &n in &sweep.bias_samples {
             for &bias in &sweep.biases {
-                level(n, bias, m, size, format!("prefilter r={:.2} bias sweep", roughness[m]), format!("{n} samples, bias {bias}"))?;
+                level(n, bias, m, size, Knob::Bias)?;
             }
         }
     }
     let n = sweep.bias_samples[sweep.bias_samples.len() - 1];
     for &size in &sweep.cube_sizes {
-        level(n, default_bias, 1, size, format!("prefilter r={:.2} cube size", roughness[1]), format!("{size}x{size}, {n} samples"))?;
+        level(n, default_bias, 1, size, Knob::Size)?;
     }
     Ok(rows)
 }
 
-fn irradiance_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
+fn irradiance_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
     for &s in &sweep.irradiance_sources {
         let level = level_of_size(source.layout, s);
@@ -422,125 +448,230 @@ fn irradiance_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References,
             .zip(&refs.irradiance)
             .map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, cube.layout, 0, d).truncate(), *r))
             .collect();
-        rows.push(Measurement::of("irradiance (convolution)", b, format!("{s}x{s} source"), ms, &errors, REL));
+        let row = b.row(Product::Irradiance, Method::Defaults, &errors, Metric::RelativeLuminance);
+        rows.push(Measurement { knob: Knob::SourceSize, source_size: Some(s), size: Some(sweep.irradiance_size), time_ms: Some(ms), ..row });
     }
     for &s in &sweep.sh_sources {
         let level = level_of_size(source.layout, s);
         let (sh, ms) = timed(|| backend.sh9(source, level))?;
         let coeffs = sh.as_vec4();
         let errors: Vec<f64> = refs.irradiance_dirs.iter().zip(&refs.irradiance).map(|(&d, r)| rel(sh9_irradiance(&coeffs, d), *r)).collect();
-        rows.push(Measurement::of("irradiance (SH9)", b, format!("{s}x{s} source"), ms, &errors, REL));
+        let row = b.row(Product::Irradiance, Method::Sh9, &errors, Metric::RelativeLuminance);
+        rows.push(Measurement { knob: Knob::SourceSize, source_size: Some(s), time_ms: Some(ms), ..row });
     }
     Ok(rows)
 }
 
-fn shaded_rows(backend: &Backend, b: &str, sweep: &Sweep, refs: &References, env: &Environment) -> Result<Vec<Measurement>> {
+fn shaded_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, env: &Environment) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
-    for (label, settings) in &sweep.qualities {
+    for settings in &sweep.qualities {
         let (baked, ms) = timed(|| bake::bake_for_display(backend, env, settings))?;
         let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
-        for &(view, lo, hi) in &VIEWS {
+        for &(lo, hi) in &VIEWS {
             let errors: Vec<f64> = refs
                 .shading
                 .iter()
-                .filter(|p| in_view(p, lo, hi))
+                .filter(|p| in_view(p, (lo, hi)))
                 .map(|p| {
                     let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, ShadeOptions::DEFAULT.flags, p.n, p.v, p.material.roughness);
                     rel(shade::ibl(ShadeOptions::DEFAULT, &p.material, p.n, p.v, s), p.full)
                 })
                 .collect();
-            rows.push(Measurement::of(format!("shaded colour {view}"), b, label.clone(), ms, &errors, REL));
+            let row = b.row(Product::ShadedColour, Method::Defaults, &errors, Metric::RelativeLuminance);
+            let (samples, size) = (Some(settings.samples), Some(settings.size));
+            rows.push(Measurement { knob: Knob::Quality, samples, size, nv_lo: Some(lo), nv_hi: Some(hi), time_ms: Some(ms), ..row });
         }
     }
     Ok(rows)
 }
 
-/// For each product and backend, the measurement with the smallest mean error × time.
-pub fn best_per_ms(rows: &[Measurement]) -> Vec<&Measurement> {
-    let mut keys: Vec<(&str, &str)> = Vec::new();
-    for r in rows.iter().filter(|r| r.time_ms.is_finite()) {
-        let k = (r.product.as_str(), r.backend.as_str());
-        if !keys.contains(&k) {
-            keys.push(k);
+/// The panel of the error-against-time figure a row belongs to, if any: every sample or
+/// size sweep and every end-to-end method (the bias and cube-size sweeps, and the bands,
+/// are in the tables only).
+pub fn panel(r: &Measurement) -> Option<String> {
+    if r.time_ms.is_none() || r.part != Part::Total || r.backend.is_empty() {
+        return None;
+    }
+    match (r.product, r.knob) {
+        (Product::Prefilter, Knob::Samples) => Some(format!("prefiltered cube, r = {:.2}", r.roughness_lo?)),
+        (Product::Prefilter, _) => None,
+        (Product::ShadedColour, Knob::Quality) => Some(format!("shaded colour, quality levels, n·v in ({}, {}]", r.nv_lo?, r.nv_hi?)),
+        (Product::ShadedColour | Product::PrefilteredLookup, _) => Some(format!("{}, end to end", r.product.title())),
+        (p, _) => Some(p.title().to_string()),
+    }
+}
+
+/// For each panel and backend, the measurement with the smallest mean error × time.
+pub fn best_per_ms(rows: &[Measurement]) -> Vec<(String, &Measurement)> {
+    let mut best: Vec<(String, &Measurement)> = Vec::new();
+    for r in rows {
+        let Some(p) = panel(r) else { continue };
+        let score = |m: &Measurement| m.mean_error * m.time_ms.unwrap_or(f64::INFINITY);
+        match best.iter_mut().find(|(q, b)| *q == p && b.backend == r.backend) {
+            Some(slot) if score(r) < score(slot.1) => slot.1 = r,
+            Some(_) => {}
+            None => best.push((p, r)),
         }
     }
-    keys.iter()
-        .filter_map(|(p, b)| {
-            rows.iter()
-                .filter(|r| r.product == *p && r.backend == *b && r.time_ms.is_finite())
-                .min_by(|x, y| (x.mean_error * x.time_ms).total_cmp(&(y.mean_error * y.time_ms)))
+    best
+}
+
+/// The small multiples of every panel: one series per method and backend.
+pub fn panels(rows: &[Measurement]) -> Vec<crate::plot::Panel> {
+    let mut panels: Vec<crate::plot::Panel> = Vec::new();
+    for r in rows {
+        let Some(title) = panel(r) else { continue };
+        let k = match panels.iter().position(|p| p.title == title) {
+            Some(k) => k,
+            None => {
+                panels.push(crate::plot::Panel { title, series: vec![] });
+                panels.len() - 1
+            }
+        };
+        let series = &mut panels[k].series;
+        let point = (r.time_ms.unwrap_or(f64::NAN), r.mean_error);
+        match series.iter_mut().find(|s| s.method == r.method && s.backend == r.backend) {
+            Some(s) => s.points.push(point),
+            None => series.push(crate::plot::Series { method: r.method, backend: r.backend.clone(), points: vec![point] }),
+        }
+    }
+    panels
+}
+
+/// A row's band, in words: roughness, `n·v`, near the sun.
+fn band(r: &Measurement) -> String {
+    let mut parts = Vec::new();
+    if let (Some(lo), Some(hi)) = (r.roughness_lo, r.roughness_hi) {
+        parts.push(if lo == hi { format!("r = {lo:.2}") } else { format!("r in [{lo}, {hi})") });
+    }
+    if let (Some(lo), Some(hi)) = (r.nv_lo, r.nv_hi) {
+        parts.push(format!("n·v in ({lo}, {hi}]"));
+    }
+    match r.near_sun {
+        Some(true) => parts.push("near the sun".into()),
+        Some(false) => parts.push("away from the sun".into()),
+        None => {}
+    }
+    if parts.is_empty() { "all".into() } else { parts.join(", ") }
+}
+
+fn part_name(p: Part) -> &'static str {
+    match p {
+        Part::Total => "total",
+        Part::Bake => "(a) bake",
+        Part::SplitSum => "(b) split sum",
+        Part::Model => "(c) model",
+    }
+}
+
+/// One of the report's tables: its title, header and cells.
+type Table = (String, [&'static str; 8], Vec<[String; 8]>);
+
+/// The report's tables: one per product, rows in measurement order.
+fn tables(rows: &[Measurement]) -> Vec<Table> {
+    let mut products: Vec<Product> = rows.iter().map(|r| r.product).collect();
+    products.sort();
+    products.dedup();
+    let header = ["method", "backend", "setting", "band", "part", "time (ms)", "mean error", "max error"];
+    products
+        .into_iter()
+        .map(|p| {
+            let cells = rows
+                .iter()
+                .filter(|r| r.product == p)
+                .map(|r| {
+                    [
+                        r.method.title().to_string(),
+                        if r.backend.is_empty() { "-".into() } else { r.backend.clone() },
+                        r.setting(),
+                        band(r),
+                        part_name(r.part).into(),
+                        r.time_ms.map_or("-".into(), |t| format!("{t:.1}")),
+                        format!("{:.2e}", r.mean_error),
+                        format!("{:.2e}", r.max_error),
+                    ]
+                })
+                .collect();
+            (p.title().to_string(), header, cells)
         })
         .collect()
 }
 
-fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement]) -> Result<()> {
-    // CSV (the csv crate quotes what needs quoting; `cost::Calibration` reads it back).
-    files::write_atomic(&dir.join("report.csv"), |w| {
-        let mut csv = csv::Writer::from_writer(w);
-        csv.write_record(["product", "backend", "setting", "time_ms", "mean_error", "max_error", "metric"])?;
-        for r in rows {
-            let (t, mean, max) = (format!("{:.4}", r.time_ms), format!("{:.6e}", r.mean_error), format!("{:.6e}", r.max_error));
-            csv.write_record([r.product.as_str(), &r.backend, &r.setting, &t, &mean, &max, r.metric])?;
-        }
-        csv.flush()
+fn html_escape(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement], map: &ErrorMap) -> Result<()> {
+    files::write_atomic(&dir.join("report.csv"), |w| splitsum::measured::write_csv(w, rows).map_err(std::io::Error::other))?;
+    let svg = |w: &mut dyn std::io::Write, drawn: std::result::Result<String, Box<dyn std::error::Error>>| -> std::io::Result<()> {
+        w.write_all(drawn.map_err(|e| std::io::Error::other(e.to_string()))?.as_bytes())
+    };
+    files::write_atomic(&dir.join("error_vs_time.svg"), |w| svg(w, crate::plot::small_multiples(&panels(rows), 3)))?;
+    for (file, rgb) in [("surface_splitsum.png", &map.splitsum), ("surface_exact.png", &map.exact), ("surface_error.png", &map.error)] {
+        files::write_png(&dir.join(file), map.width, map.height, rgb)?;
+    }
+    files::write_atomic(&dir.join("surface_scale.svg"), |w| {
+        svg(w, crate::plot::colour_scale("relative luminance error", crate::surface::false_colour, &crate::surface::scale_ticks()))
     })?;
+
+    let devices = backends.iter().map(|b| b.describe()).collect::<Vec<_>>().join("; ");
+    let setup = format!(
+        "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)). Backends: {devices}.",
+        sweep.source_size, sweep.specular_size, sweep.mips
+    );
+    let references = "References (f64, independent of the code under test): adaptive Gauss-Kronrod quadrature for the BRDF table; exact sums over every texel of the source for the prefilter and the irradiance; the full reflectance integral (exact Smith, no split) for the shaded colour. Errors are relative: of the luminance, and for the table of the directional albedo F0*A + B (the larger of F0 = 0.04 and 1). Times are wall-clock, uploads and readbacks included.";
+    let surface = format!(
+        "Sphere grid (metal above, dielectric below; roughness {} across), orthographic view, shaded by splitsum from the default bake on {} against the exact integral: mean relative error {:.2}%, max {:.0}%.",
+        crate::surface::ROUGHNESS.iter().map(|r| format!("{r}")).collect::<Vec<_>>().join(", "),
+        backends[0].describe(),
+        100.0 * map.mean,
+        100.0 * map.max
+    );
+    let tables = tables(rows);
+    let best = best_per_ms(rows);
 
     // Markdown.
     let mut md = String::new();
-    let _ = writeln!(md, "# splitsum: error against run time\n");
-    let _ = writeln!(
-        md,
-        "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)).",
-        sweep.source_size, sweep.specular_size, sweep.mips
-    );
-    let _ = writeln!(md, "Backends: {}.\n", backends.iter().map(|b| b.describe()).collect::<Vec<_>>().join("; "));
-    let _ = writeln!(
-        md,
-        "References (f64, independent of the code under test): adaptive Gauss-Kronrod quadrature for the BRDF table; exact sums over every texel of the source for the prefilter and the irradiance; the full reflectance integral (no split) for the shaded colour. Errors are absolute for the table and relative luminance otherwise. Times are wall-clock, uploads and readbacks included.\n"
-    );
-    let mut products: Vec<&str> = Vec::new();
-    for r in rows {
-        if !products.contains(&r.product.as_str()) {
-            products.push(&r.product);
+    let _ = writeln!(md, "# splitsum: error against run time\n\n{setup}\n\n{references}\n");
+    let _ = writeln!(md, "![error against run time](error_vs_time.svg)\n\n{surface}\n\n| splitsum | exact | error |\n|---|---|---|\n| ![](surface_splitsum.png) | ![](surface_exact.png) | ![](surface_error.png) |\n\n![scale](surface_scale.svg)");
+    for (title, header, cells) in &tables {
+        let _ = writeln!(md, "\n## {title}\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
+        for c in cells {
+            let _ = writeln!(md, "| {} |", c.join(" | "));
         }
     }
-    for product in &products {
-        let _ = writeln!(md, "\n## {product}\n\n| backend | setting | time (ms) | mean error | max error |\n|---|---|---:|---:|---:|");
-        for r in rows.iter().filter(|r| r.product == *product) {
-            let t = if r.time_ms.is_finite() { format!("{:.1}", r.time_ms) } else { "-".into() };
-            let _ = writeln!(md, "| {} | {} | {} | {:.2e} | {:.2e} |", r.backend, r.setting, t, r.mean_error, r.max_error);
-        }
-    }
-    let _ = writeln!(
-        md,
-        "\n## Best error per millisecond (smallest mean error x time)\n\n| product | backend | setting | time (ms) | mean error |\n|---|---|---|---:|---:|"
-    );
-    for r in best_per_ms(rows) {
-        let _ = writeln!(md, "| {} | {} | {} | {:.1} | {:.2e} |", r.product, r.backend, r.setting, r.time_ms, r.mean_error);
+    let _ = writeln!(md, "\n## Best error per millisecond (smallest mean error x time)\n\n| panel | backend | setting | time (ms) | mean error |\n|---|---|---|---:|---:|");
+    for (p, r) in &best {
+        let _ = writeln!(md, "| {p} | {} | {} | {:.1} | {:.2e} |", r.backend, r.setting(), r.time_ms.unwrap_or(f64::NAN), r.mean_error);
     }
     files::write_atomic(&dir.join("report.md"), |w| std::io::Write::write_all(w, md.as_bytes()))?;
 
-    // Plot: the sample or size sweeps, one curve per product and backend.
-    let mut series = Vec::new();
-    let mut products: Vec<&str> = rows
-        .iter()
-        .filter(|r| r.time_ms.is_finite() && !r.product.contains("bias sweep") && !r.product.contains("cube size"))
-        .map(|r| r.product.as_str())
-        .collect();
-    products.dedup();
-    products.sort();
-    products.dedup();
-    for (pi, p) in products.iter().enumerate() {
-        for (bi, b) in backends.iter().enumerate() {
-            let name = b.describe();
-            let points: Vec<(f64, f64)> = rows.iter().filter(|r| r.product == *p && r.backend == name).map(|r| (r.time_ms, r.mean_error)).collect();
-            if !points.is_empty() {
-                let short = if name.starts_with("gpu") { "gpu" } else { "cpu" };
-                series.push(Series { label: format!("{p} ({short})"), points, color: plot::palette(pi), dashed: bi > 0 });
-            }
+    // HTML: the same, every figure inline beside its caption.
+    let mut html = String::new();
+    let _ = writeln!(
+        html,
+        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>splitsum: error against run time, {}</title>\n<style>body{{font-family:sans-serif;max-width:1120px;margin:2em auto;color:#222}} table{{border-collapse:collapse;font-size:13px;margin:0.5em 0 1.5em}} td,th{{border:1px solid #ccc;padding:2px 6px;text-align:right}} td:nth-child(-n+5),th:nth-child(-n+5){{text-align:left}} figure{{margin:1em 0}} .maps img{{image-rendering:pixelated;border:1px solid #ddd;margin-right:8px}}</style></head><body>",
+        html_escape(name)
+    );
+    let _ = writeln!(html, "<h1>splitsum: error against run time</h1>\n<p>{}</p>\n<p>{}</p>", html_escape(&setup), html_escape(references));
+    let _ = writeln!(html, "<figure id=\"error-vs-time\"><img src=\"error_vs_time.svg\" alt=\"error against run time, one panel per product\"><figcaption>Mean relative error against bake time, one panel per product: one colour per method, the GPU solid and the CPU dashed; ringed points are each panel's Pareto front.</figcaption></figure>");
+    let _ = writeln!(
+        html,
+        "<figure id=\"surfaces\" class=\"maps\"><img src=\"surface_splitsum.png\" alt=\"splitsum\"><img src=\"surface_exact.png\" alt=\"exact\"><img src=\"surface_error.png\" alt=\"error\"><br><img src=\"surface_scale.svg\" alt=\"error scale\"><figcaption>Left to right: splitsum, the exact integral, their relative error. {}</figcaption></figure>",
+        html_escape(&surface)
+    );
+    for (title, header, cells) in &tables {
+        let _ = writeln!(html, "<h2>{}</h2>\n<table><tr>{}</tr>", html_escape(title), header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>());
+        for c in cells {
+            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
         }
+        let _ = writeln!(html, "</table>");
     }
-    let canvas = plot::log_log("ERROR AGAINST RUN TIME", "TIME (MS)", "MEAN ERROR", &series, 1100, 640);
-    files::write_png(&dir.join("error_vs_time.png"), canvas.width, canvas.height, &canvas.rgb)?;
+    let _ = writeln!(html, "<h2>Best error per millisecond</h2>\n<table><tr><th>panel</th><th>backend</th><th>setting</th><th>time (ms)</th><th>mean error</th></tr>");
+    for (p, r) in &best {
+        let _ = writeln!(html, "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.2e}</td></tr>", html_escape(p), r.backend, html_escape(&r.setting()), r.time_ms.unwrap_or(f64::NAN), r.mean_error);
+    }
+    let _ = writeln!(html, "</table></body></html>");
+    files::write_atomic(&dir.join("report.html"), |w| std::io::Write::write_all(w, html.as_bytes()))?;
     Ok(())
 }

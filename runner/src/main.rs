@@ -2,7 +2,7 @@
 
 fn main() {
     quiet_device_select();
-    env_logger::Builder::from_env(env_logger::Env::default().default_filter_or("warn")).init();
+    runner::log_warnings();
     if let Err(e) = runner::cli::run(std::env::args_os()) {
         match e.downcast_ref::<clap::Error>() {
             // Help and version exit 0, usage errors 2 (`cli::USAGE_EXIT`).

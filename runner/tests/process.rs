@@ -45,6 +45,8 @@ fn write_equirect(path: &Path, width: usize, sun: f32) {
 /// alone, whatever other tests run beside it).
 fn run_measured(mut command: Command, dir: &Path) -> (bool, String, u64) {
     let (out, err) = (dir.join("stdout.txt"), dir.join("stderr.txt"));
+    // Reaped by wait4 below, which also gives the peak memory `Child::wait` does not.
+    #[allow(clippy::zombie_processes)]
     let child = command.stdout(std::fs::File::create(&out).unwrap()).stderr(std::fs::File::create(&err).unwrap()).spawn().unwrap();
     let mut status = 0;
     let mut usage = std::mem::MaybeUninit::<libc::rusage>::zeroed();
@@ -265,7 +267,7 @@ fn large_face_folders_bake_on_the_gpu() {
     std::fs::create_dir_all(&faces).unwrap();
     for (k, name) in ["px", "nx", "py", "ny", "pz", "nz"].iter().enumerate() {
         let ch = SpecificChannels::rgb(move |p: Vec2<usize>| {
-            let v = 0.2 + 0.1 * k as f32 + if (p.x() / 64 + p.y() / 64) % 2 == 0 { 0.5 } else { 0.0 };
+            let v = 0.2 + 0.1 * k as f32 + if (p.x() / 64 + p.y() / 64).is_multiple_of(2) { 0.5 } else { 0.0 };
             (f16::from_f32(v), f16::from_f32(0.5 * v), f16::from_f32(0.25 * v))
         });
         Image::from_channels((2048, 2048), ch).write().to_file(faces.join(format!("{name}.exr"))).unwrap();
@@ -558,7 +560,7 @@ fn hostile_headers_stay_within_memory_bounds() {
     assert!(ok && said.contains("rejected (specular.bin is corrupt (its BLAKE3 hash differs"), "{said}");
     assert!(peak <= (64 << 20) + scene_baseline, "peak {peak}");
     for (what, input, message) in &cases {
-        let len = std::fs::metadata(input).map(|m| if m.is_dir() { 6 * 16 << 10 } else { m.len() }).unwrap();
+        let len = std::fs::metadata(input).map(|m| if m.is_dir() { (6 * 16) << 10 } else { m.len() }).unwrap();
         let (ok, said, peak) = run_measured(bake(input), &d);
         let bound = (64 << 20) + 4 * len + baseline;
         eprintln!("{what}: peak {:.1} MiB (bound {:.1} MiB): {}", peak as f64 / 1048576.0, bound as f64 / 1048576.0, said.lines().last().unwrap_or(""));
@@ -583,7 +585,7 @@ fn split_glb(glb: &[u8]) -> (Vec<u8>, Vec<u8>) {
 fn join_glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
     let pad = |v: &[u8], with: u8| {
         let mut v = v.to_vec();
-        while v.len() % 4 != 0 {
+        while !v.len().is_multiple_of(4) {
             v.push(with);
         }
         v

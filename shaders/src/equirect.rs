@@ -219,7 +219,7 @@ pub fn row_solid_angle(y: u32, height: u32) -> f32 {
 pub fn reduction_factor(width: u32, height: u32, face_size: u32) -> u32 {
     let need = math::TAU * face_size as f32;
     let mut f = 1;
-    while (width / f) % 2 == 0 && (height / f) % 2 == 0 && (width / f / 2) as f32 >= need {
+    while (width / f).is_multiple_of(2) && (height / f).is_multiple_of(2) && (width / f / 2) as f32 >= need {
         f *= 2;
     }
     f

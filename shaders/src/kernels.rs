@@ -6,8 +6,9 @@
 //! Texel kernels run 8×8 invocations per workgroup with `z` the cube face.
 //!
 //! Long sums (BRDF table, prefilter, irradiance) run one chunk of at most `math::CHUNK`
-//! terms per dispatch, carrying compensated partial sums in the output buffer; the host
-//! resolves them with the same functions the CPU backend uses.
+//! terms per dispatch, carrying compensated partial sums in the output buffer;
+//! [`resolve_means`] and [`resolve_lut`] resolve them on the device with the same functions
+//! the CPU backend uses.
 
 use crate::brdf::microfacet::Masking;
 use crate::cubemap::{self, CubeLayout};
@@ -34,8 +35,8 @@ pub struct LutParams {
 }
 
 /// One chunk of one texel of the split-sum BRDF table: adds samples `start..start+count`
-/// to the compensated partial sums `accum[y·size + x]` (`lut::accumulate`); the host
-/// resolves the sums with `lut::resolve` once every chunk has run.
+/// to the compensated partial sums `accum[y·size + x]` (`lut::accumulate`); [`resolve_lut`]
+/// resolves them (`lut::resolve`) once every chunk has run.
 #[spirv(compute(threads(8, 8)))]
 pub fn brdf_lut(
     #[spirv(global_invocation_id)] id: UVec3,
@@ -196,8 +197,9 @@ fn store_partial(accum: &mut [Vec4], i: usize, p: MeanPartial) {
 }
 
 /// One chunk of samples of one texel of one level of the prefiltered specular cube: adds
-/// them to the texel's partial sums in `accum` (three `Vec4` per texel); the host resolves
-/// the means once every chunk has run (`prefilter::accumulate`, `MeanPartial::resolve`).
+/// them to the texel's partial sums in `accum` (three `Vec4` per texel); [`resolve_means`]
+/// resolves the means once every chunk has run (`prefilter::accumulate`,
+/// `MeanPartial::resolve`).
 #[spirv(compute(threads(8, 8)))]
 pub fn prefilter_specular(
     #[spirv(global_invocation_id)] id: UVec3,

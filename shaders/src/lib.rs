@@ -11,6 +11,7 @@
 //! the diffuse irradiance ([`irradiance`]); the BRDF table ([`lut`]) needs no environment.
 //! [`brdf`] holds the reflectance models, [`sampling`] the sample generators and [`math`]
 //! the elementary functions both backends evaluate identically.
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
 #![no_std]
 
 pub mod brdf;

@@ -41,7 +41,7 @@ pub const FRAC_1_PI: f32 = core::f32::consts::FRAC_1_PI;
 pub const TAU: f32 = core::f32::consts::TAU;
 
 // Taylor coefficients of sin(2πf) and cos(2πf) in powers of f, (2π)^k / k! with signs.
-const S1: f32 = 6.283_185_307_179_586;
+const S1: f32 = core::f32::consts::TAU;
 const S3: f32 = -41.341_702_240_399_76;
 const S5: f32 = 81.605_249_276_075_04;
 const S7: f32 = -76.705_859_753_061_4;

@@ -4,7 +4,9 @@
 //! **Direct light** (Karis 2013, "Specular BRDF"; LearnOpenGL "Lighting"): for each light of
 //! radiance `E` arriving from `l`,
 //! `L_o = (k_d f_d + f_s) E (n·l)` with, for Cook–Torrance, `f_s = D·Vis·F`, GGX `D`
-//! (α = r²), Smith–Schlick visibility with `k = (r+1)²/8`, Fresnel at `v·h`, and the
+//! (α = r²), the exact height-correlated Smith visibility (Heitz 2014, eq. 99; the default,
+//! [`ShadeOptions::CORRELATED_SMITH`]) or Smith–Schlick with `k = (r+1)²/8` (Karis 2013),
+//! Fresnel at `v·h`, and the
 //! diffuse weight `k_d = (1 − F)(1 − metallic)` (Lambert, Oren–Nayar). The Fresnel-weighted
 //! diffuse carries its own Fresnel factor and is weighted by `1 − metallic` only.
 //!

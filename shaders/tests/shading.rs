@@ -135,7 +135,7 @@ fn filament_mapping_is_cmgens_and_filaments_lod_inverts_it() {
     for mips in 2..=9u32 {
         for m in 0..mips {
             let t = m as f64 / (mips - 1) as f64;
-            let cmgen = if t != 0.0 { (((4.0 - 4.0 * t) as f64).sqrt() - 2.0) / -2.0 } else { 0.0 };
+            let cmgen = if t != 0.0 { ((4.0 - 4.0 * t).sqrt() - 2.0) / -2.0 } else { 0.0 };
             let r = f.roughness(m, mips);
             assert!((r as f64 - cmgen).abs() < 1e-6, "M {mips}, mip {m}: {r} vs cmgen {cmgen}");
             let lod = (mips - 1) as f64 * r as f64 * (2.0 - r as f64);

@@ -9,6 +9,7 @@
 //! source, so it cannot disagree with it; CI regenerates both and fails on any
 //! difference, so they cannot drift from `shaders/`.
 
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
 #![no_std]
 #![warn(missing_docs)]
 

@@ -244,12 +244,11 @@ impl Cache {
         let manifest = Manifest { format: FORMAT.into(), key: key.into(), mapping: env.mapping as u32, files };
         std::fs::write(tmp.join("manifest.json"), serde_json::to_string_pretty(&manifest).expect("serialisable")).map_err(fail)?;
         let dest = self.entry(key);
-        if dest.exists() {
-            if let Err(e) = remove_entry(&dest) {
+        if dest.exists()
+            && let Err(e) = remove_entry(&dest) {
                 let _ = std::fs::remove_dir_all(&tmp);
                 return Err(e);
             }
-        }
         std::fs::rename(&tmp, &dest).map_err(|e| {
             let _ = std::fs::remove_dir_all(&tmp);
             fail(e)

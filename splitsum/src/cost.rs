@@ -2,7 +2,8 @@
 //! ([`Calibration`]), and the time and memory of a resolved bake ([`estimate`],
 //! [`step_seconds`]).
 
-use crate::settings::{InputShape, Job, Settings, Step, TableMethod};
+use crate::measured::{Knob, Measurement, Method, Part, Product};
+use crate::settings::{InputShape, Job, Step, TableMethod};
 use serde::Serialize;
 
 /// Error of each product against its reference, per setting, and the cost rates of each
@@ -13,11 +14,9 @@ use serde::Serialize;
 pub struct Calibration {
     /// Where the numbers come from.
     pub source: String,
-    /// BRDF table: (samples, mean absolute error).
-    pub lut: Vec<(u32, f64)>,
     /// The specular bake, end to end: (roughness at the middle of a band, [(samples at mip
     /// 1, mean relative error the bake adds to the shaded colour)]), from the report's
-    /// `shaded colour r in [a, b): (a) bake` rows of the defaults at several sample counts.
+    /// rows of the shaded colour's bake share for the defaults at several sample counts.
     pub prefilter: Vec<(f32, Vec<(u32, f64)>)>,
     /// Irradiance convolution: (source face size, mean relative error).
     pub irradiance: Vec<(u32, f64)>,
@@ -40,7 +39,6 @@ impl Default for Calibration {
     fn default() -> Self {
         Self {
             source: "built in: runner report on city.exr and courtyard.exr (the worse of the two), runner bench, lavapipe and 2 CPU cores".into(),
-            lut: vec![(16, 1.98e-2), (64, 6.62e-3), (256, 2.56e-3), (1024, 8.86e-4), (4096, 2.93e-4)],
             // Bands [0.02, 0.05) … [0.75, 1] of `runner report` on city.exr and courtyard.exr
             // (the worse of the two), CPU backend.
             prefilter: vec![
@@ -62,56 +60,42 @@ impl Default for Calibration {
     }
 }
 
-/// A `report.csv` row of the end-to-end measure's bake share for the defaults at some
-/// sample count: product `shaded colour r in [a, b): (a) bake`, setting `defaults` or
-/// `defaults, N samples`; gives the band's middle and `N`.
-fn bake_share(product: &str, setting: &str) -> Option<(f32, u32)> {
-    let band = product.strip_prefix("shaded colour r in [")?.strip_suffix(": (a) bake")?;
-    let (a, rest) = band.split_once(", ")?;
-    let b = rest.trim_end_matches([')', ']']);
-    let (a, b): (f32, f32) = (a.parse().ok()?, b.parse().ok()?);
-    let n = if setting == "defaults" { Settings::default().samples } else { setting.strip_prefix("defaults, ")?.strip_suffix(" samples")?.parse().ok()? };
-    Some((0.5 * (a + b), n))
-}
-
 impl Calibration {
-    /// Reads the error model from a `report.csv` of `runner report` (its first backend),
-    /// keeping the built-in cost rates; `None` if it has no rows of a product.
+    /// The error model from `report.csv` of `runner report` (its first backend's rows),
+    /// keeping the built-in cost rates; `None` if the text is not such a file or lacks
+    /// the rows of a product.
     pub fn from_report_csv(text: &str) -> Option<Self> {
-        let mut c = Calibration { source: "report.csv".into(), lut: vec![], prefilter: vec![], irradiance: vec![], ..Default::default() };
-        let mut backend: Option<String> = None;
-        let mut reader = csv::ReaderBuilder::new().flexible(true).from_reader(text.as_bytes());
-        for record in reader.records() {
-            let f = record.ok()?;
-            if f.len() < 7 {
-                continue;
-            }
-            if backend.is_none() && &f[3] != "NaN" {
-                backend = Some(f[1].to_string());
-            }
-            if Some(&f[1]) != backend.as_deref() {
-                continue;
-            }
-            let err: f64 = f[4].parse().ok()?;
-            let first_number = |s: &str| s.split(|ch: char| !ch.is_ascii_digit()).find(|t| !t.is_empty()).and_then(|t| t.parse::<u32>().ok());
-            if &f[0] == "brdf lut" {
-                // The sampled table's rows (the quadrature's row has no sample count).
-                if let Some(n) = first_number(&f[2]) {
-                    c.lut.push((n, err));
+        Self::from_measurements(&crate::measured::read_csv(text).ok()?)
+    }
+
+    /// The error model from a report's rows (its first backend's), by their columns:
+    /// the irradiance convolution's error per source size, and the bake's share of the
+    /// shaded colour's error per roughness band and sample count, for the defaults.
+    pub fn from_measurements(rows: &[Measurement]) -> Option<Self> {
+        let mut c = Calibration { source: "report.csv".into(), prefilter: vec![], irradiance: vec![], ..Default::default() };
+        let backend = &rows.iter().find(|r| !r.backend.is_empty())?.backend;
+        for r in rows.iter().filter(|r| &r.backend == backend) {
+            match (r.product, r.method, r.part) {
+                (Product::Irradiance, Method::Defaults, Part::Total) if r.knob == Knob::SourceSize => {
+                    c.irradiance.push((r.source_size?, r.mean_error));
                 }
-            } else if &f[0] == "irradiance (convolution)" {
-                c.irradiance.push((first_number(&f[2])?, err));
-            } else if let Some((r, n)) = bake_share(&f[0], &f[2]) {
-                match c.prefilter.iter_mut().find(|(x, _)| (*x - r).abs() < 1e-3) {
-                    Some((_, v)) => {
-                        v.push((n, err));
-                        v.sort_by_key(|&(n, _)| n);
+                (Product::ShadedColour, Method::Defaults, Part::Bake) => {
+                    let (Some(lo), Some(hi), Some(n)) = (r.roughness_lo, r.roughness_hi, r.samples) else { continue };
+                    let mid = 0.5 * (lo + hi);
+                    match c.prefilter.iter_mut().find(|(x, _)| (*x - mid).abs() < 1e-3) {
+                        Some((_, v)) => {
+                            v.push((n, r.mean_error));
+                            v.sort_by_key(|&(n, _)| n);
+                        }
+                        None => c.prefilter.push((mid, vec![(n, r.mean_error)])),
                     }
-                    None => c.prefilter.push((r, vec![(n, err)])),
                 }
+                _ => {}
             }
         }
-        (!c.lut.is_empty() && !c.prefilter.is_empty() && !c.irradiance.is_empty()).then_some(c)
+        c.irradiance.sort_by_key(|&(s, _)| s);
+        c.prefilter.sort_by(|a, b| a.0.total_cmp(&b.0));
+        (!c.prefilter.is_empty() && !c.irradiance.is_empty()).then_some(c)
     }
 
     /// The bake's share of the shaded colour's error at `roughness` (the nearest band) with

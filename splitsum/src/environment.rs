@@ -539,11 +539,10 @@ fn exr_raw_data_window(r: &mut impl std::io::BufRead) -> Option<[i32; 4]> {
 /// the offset table and its own header).
 fn exr_header<R: std::io::BufRead + std::io::Seek>(path: &Path, reader: &mut R, len: u64) -> Result<ExrHeader> {
     let malformed = |why: String| Error::file(path, format!("malformed OpenEXR: {why}"));
-    if let Some([x0, y0, x1, y1]) = exr_raw_data_window(reader) {
-        if x1 < x0 || y1 < y0 {
+    if let Some([x0, y0, x1, y1]) = exr_raw_data_window(reader)
+        && (x1 < x0 || y1 < y0) {
             return Err(malformed(format!("its data window is inverted (from ({x0}, {y0}) to ({x1}, {y1}))")));
         }
-    }
     reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
     let meta = exr::meta::MetaData::read_from_buffered(reader, false).map_err(|e| exr_error(path, e))?;
     let header = meta.headers.iter().find(|h| !h.deep && exr_channels(h).is_some()).ok_or_else(|| {
@@ -709,7 +708,7 @@ struct Reducer {
 
 impl Reducer {
     fn new(width: u32, height: u32, factor: u32, weights: Weights, sanitize: bool) -> Self {
-        let factor = if width % factor == 0 && height % factor == 0 { factor.max(1) } else { 1 };
+        let factor = if width.is_multiple_of(factor) && height.is_multiple_of(factor) { factor.max(1) } else { 1 };
         let (ow, oh) = (width / factor, height / factor);
         let rows = factor > 1 && matches!(weights, Weights::EquirectRows);
         let row_weight = if rows { (0..height).map(|y| equirect::row_solid_angle(y, height) as f64).collect() } else { Vec::new() };

@@ -16,7 +16,8 @@
 
 use crate::error::Result;
 use crate::files::write_atomic;
-use crate::texture::{Cube, Lut};
+pub use crate::texture::Format;
+use crate::texture::{Cube, Lut, max_value};
 use splitsum_shaders::half::{f32_to_f16_bits, pack_rgb9e5};
 use std::io::Write;
 use std::path::Path;
@@ -32,22 +33,6 @@ pub const VK_FORMAT_E5B9G9R9_UFLOAT_PACK32: u32 = 123;
 pub const VK_FORMAT_B10G11R11_UFLOAT_PACK32: u32 = 122;
 pub use splitsum_shaders::half::{HALF_MAX, RGB9E5_MAX};
 
-/// Texel format of a written cube.
-#[derive(Copy, Clone, Debug, PartialEq, Eq)]
-pub enum Format {
-    /// RGBA16F, or RGBA32F when a value exceeds the half-float range.
-    Auto,
-    /// Half floats; values above 65504 are clamped (and counted).
-    Rgba16f,
-    /// Single floats.
-    Rgba32f,
-    /// `E5B9G9R9_UFLOAT_PACK32`: four bytes a texel, RGB with a shared exponent (9-bit
-    /// mantissas; Bevy's own environment maps), no alpha; values above 65408 are clamped
-    /// (and counted).
-    Rgb9e5,
-}
-
-splitsum_shaders::choice!(Format: Auto => "auto", Rgba16f => "rgba16f", Rgba32f => "rgba32f", Rgb9e5 => "rgb9e5");
 
 /// What writing a cube did to its values (KTX2, and KTX 1.1 by its Vulkan twin format).
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -58,21 +43,6 @@ pub struct Written {
     pub clamped: u64,
     /// The largest value in the cube.
     pub max_value: f32,
-}
-
-impl Format {
-    /// The format that writing `cube` with `self` uses.
-    pub fn resolve(self, cube: &Cube) -> Format {
-        match self {
-            Format::Auto if max_value(cube) > HALF_MAX => Format::Rgba32f,
-            Format::Auto => Format::Rgba16f,
-            f => f,
-        }
-    }
-}
-
-fn max_value(cube: &Cube) -> f32 {
-    cube.texels.iter().map(|t| t.x.max(t.y).max(t.z).max(t.w)).fold(0.0, f32::max)
 }
 
 fn round_up(x: usize, to: usize) -> usize {
@@ -188,7 +158,7 @@ fn container(kformat: ::ktx2::Format, size: u32, faces: u32, payloads: Vec<Vec<u
     let texel_bytes = payloads[0].len() / (faces as usize * size as usize * size as usize);
     let raw_lengths: Vec<usize> = payloads.iter().map(Vec::len).collect();
     let (align, stored): (usize, Vec<Vec<u8>>) = match sc {
-        Supercompression::None => (if texel_bytes % 4 == 0 { texel_bytes } else { texel_bytes * 4 }, payloads),
+        Supercompression::None => (if texel_bytes.is_multiple_of(4) { texel_bytes } else { texel_bytes * 4 }, payloads),
         Supercompression::Zstd => {
             (1, payloads.iter().map(|p| ruzstd::encoding::compress_to_vec(p.as_slice(), ruzstd::encoding::CompressionLevel::Fastest)).collect())
         }

@@ -14,6 +14,7 @@
 //! and the files written (`examples/bake.rs`; `tests/library.rs` runs it on Vulkan, on GL
 //! and with [`Compute::Cpu`]):
 //!
+#![cfg_attr(not(test), warn(unused_crate_dependencies))]
 #![doc = concat!("```no_run\n", include_str!("../examples/bake.rs"), "\n```")]
 //!
 //! ## What is where
@@ -76,6 +77,7 @@ internal_modules! {
     host;
     ktx1;
     ktx2;
+    measured;
     preview;
     progress;
 }
@@ -86,7 +88,8 @@ pub use crate::bake::{Baked, Timing, bake, bake_job};
 pub use environment::{Environment, InputReport, InputShape};
 pub use error::{Error, Result};
 pub use field::{Field, Step};
-pub use crate::ktx2::{Format, Written};
+pub use crate::ktx2::Written;
+pub use texture::Format;
 pub use output::{About, Manifest};
 pub use settings::{Job, Products, Settings, TableMethod, Target};
 pub use splitsum_shaders::brdf::microfacet::Masking;

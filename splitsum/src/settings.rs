@@ -6,7 +6,7 @@ use crate::adjustment::Adjustment;
 pub use crate::environment::InputShape;
 pub use crate::field::{Field, Step};
 use crate::error::{Error, Result};
-use crate::ktx2::Format;
+use crate::texture::Format;
 use serde::{Deserialize, Serialize};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::choice::Choice;

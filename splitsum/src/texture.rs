@@ -3,6 +3,7 @@
 
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::glam::{Vec2, Vec4};
+use splitsum_shaders::half::HALF_MAX;
 
 /// The split-sum BRDF table: `size`×`size` `(scale, bias)` pairs, row `y` = roughness.
 #[derive(Clone, Debug)]
@@ -123,3 +124,37 @@ pub fn mip_chain_rgba8(width: u32, height: u32, rgba: &[u8], srgb: bool) -> Vec<
     }
     levels
 }
+
+/// Texel format of a written cube (KTX2, KTX 1.1 by its Vulkan twin: `crate::ktx2`).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// RGBA16F, or RGBA32F when a value exceeds the half-float range.
+    Auto,
+    /// Half floats; values above 65504 are clamped (and counted).
+    Rgba16f,
+    /// Single floats.
+    Rgba32f,
+    /// `E5B9G9R9_UFLOAT_PACK32`: four bytes a texel, RGB with a shared exponent (9-bit
+    /// mantissas; Bevy's own environment maps), no alpha; values above 65408 are clamped
+    /// (and counted).
+    Rgb9e5,
+}
+
+splitsum_shaders::choice!(Format: Auto => "auto", Rgba16f => "rgba16f", Rgba32f => "rgba32f", Rgb9e5 => "rgb9e5");
+
+impl Format {
+    /// The format that writing `cube` with `self` uses.
+    pub fn resolve(self, cube: &Cube) -> Format {
+        match self {
+            Format::Auto if max_value(cube) > HALF_MAX => Format::Rgba32f,
+            Format::Auto => Format::Rgba16f,
+            f => f,
+        }
+    }
+}
+
+/// The largest channel value of `cube`.
+pub(crate) fn max_value(cube: &Cube) -> f32 {
+    cube.texels.iter().map(|t| t.x.max(t.y).max(t.z).max(t.w)).fold(0.0, f32::max)
+}
+

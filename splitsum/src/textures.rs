@@ -518,7 +518,7 @@ async fn read_halves(device: &wgpu::Device, queue: &wgpu::Queue, t: &wgpu::Textu
         for r in 0..(s * layers) as usize {
             let w = &words[r * (row / 4) as usize..];
             for x in 0..s as usize {
-                let h = |k: usize| f16_bits_to_f32(if k % 2 == 0 { w[k / 2] & 0xffff } else { w[k / 2] >> 16 });
+                let h = |k: usize| f16_bits_to_f32(if k.is_multiple_of(2) { w[k / 2] & 0xffff } else { w[k / 2] >> 16 });
                 let c = channels as usize * x;
                 out.push(if channels == 4 { Vec4::new(h(c), h(c + 1), h(c + 2), h(c + 3)) } else { Vec4::new(h(c), h(c + 1), 0.0, 0.0) });
             }

@@ -111,7 +111,7 @@ pub fn sample_glb() -> Vec<u8> {
     let mut bin: Vec<u8> = Vec::new();
     let mut views = Vec::new();
     let mut push = |bytes: &[u8], bin: &mut Vec<u8>| {
-        while bin.len() % 4 != 0 {
+        while !bin.len().is_multiple_of(4) {
             bin.push(0);
         }
         views.push(serde_json::json!({"buffer": 0, "byteOffset": bin.len(), "byteLength": bytes.len()}));
@@ -125,7 +125,7 @@ pub fn sample_glb() -> Vec<u8> {
     let vu = push(&f32s(&uv.concat()), &mut bin);
     let vi = push(&idx.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>(), &mut bin);
     let images: Vec<usize> = textures().iter().map(|png| push(png, &mut bin)).collect();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let (lo, hi) = p.iter().fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), q| {
@@ -172,7 +172,7 @@ pub fn sample_glb() -> Vec<u8> {
 /// padded to 4 bytes), after the 12-byte header.
 pub fn glb(json: &serde_json::Value, bin: &[u8]) -> Vec<u8> {
     let mut text = serde_json::to_vec(json).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let mut glb = Vec::new();
@@ -201,7 +201,7 @@ pub fn draco_glb(stream: &[u8], ids: [(&str, u32, &str); 3], count: usize, faces
     }
     accessors.push(serde_json::json!({"componentType": 5125, "count": 3 * faces, "type": "SCALAR"}));
     let mut bin = stream.to_vec();
-    while bin.len() % 4 != 0 {
+    while !bin.len().is_multiple_of(4) {
         bin.push(0);
     }
     let json = serde_json::json!({

@@ -33,9 +33,10 @@ pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
     let rows = crate::report::run(&env, &name, &backends, &sweep, out.path())?;
     out.commit()?;
     println!("{} measurements in {:.1} s", rows.len(), start.elapsed().as_secs_f64());
-    for r in crate::report::best_per_ms(&rows) {
-        println!("  best error per ms: {:<28} {:<8} {:<24} {:>9.1} ms  mean error {:.2e}", r.product, &r.backend[..3], r.setting, r.time_ms, r.mean_error);
+    for (panel, r) in crate::report::best_per_ms(&rows) {
+        let ms = r.time_ms.unwrap_or(f64::NAN);
+        println!("  best error per ms: {panel:<44} {:<4} {:<24} {ms:>9.1} ms  mean error {:.2e}", r.backend, r.setting(), r.mean_error);
     }
-    println!("wrote {}/report.md, report.csv, error_vs_time.png", args.out.display());
+    println!("wrote {0}/report.html (open it in a browser), report.md, report.csv and the figures", args.out.display());
     Ok(())
 }

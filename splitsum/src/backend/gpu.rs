@@ -3,8 +3,11 @@
 //! size and bindings come from that crate's generated linkage; nothing here spells one.
 //!
 //! Start-up (device and every pipeline) happens in [`Gpu::new`] or [`Gpu::on_device`], so
-//! that the time of a bake excludes it. Dispatches are recorded into one command encoder
-//! per product and submitted together.
+//! that the time of a bake excludes it. Each [`Gpu::run`] records its dispatches in one
+//! command encoder and submits them: a step's levels together, and each chunk of a long sum
+//! (at most `math::CHUNK` terms, under drivers' time limits per submission) on its own; the
+//! chunks' partial sums are resolved on the device (`resolve_means`, `resolve_lut`) before
+//! anything is read back.
 
 use super::cpu::Cpu;
 use super::kernels::{Kernels, Prefilter, chunks};
@@ -252,7 +255,7 @@ impl Gpu {
     /// The largest buffer this device binds as one storage buffer.
     pub fn max_binding(&self) -> u64 {
         let limits = self.device.limits();
-        (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size)
+        limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
     }
 
     /// An output storage buffer of `bytes` bytes, checked against the device's limits.

@@ -1,0 +1,240 @@
+//! What `runner report` measures, typed: one row of error against run time
+//! ([`Measurement`]), the product it measures, the method, the part of the error, the knob
+//! swept and its value in numeric columns. `report.csv` is these rows through serde, and
+//! [`crate::cost::Calibration`] reads them back by their columns: no label is parsed.
+
+use serde::{Deserialize, Serialize};
+
+/// What is measured.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Product {
+    /// The BRDF table at its texel centres.
+    BrdfTable,
+    /// The BRDF table read bilinearly between texel centres.
+    BrdfTableLookup,
+    /// One level of the prefiltered cube against the exact prefiltered radiance.
+    Prefilter,
+    /// The irradiance (convolution or SH9) against the exact `E/π`.
+    Irradiance,
+    /// The shaded colour against the full reflectance integral.
+    ShadedColour,
+    /// The prefiltered radiance a renderer reads at any roughness (the mips blended).
+    PrefilteredLookup,
+}
+
+impl Product {
+    /// Its name in the report.
+    pub fn title(self) -> &'static str {
+        match self {
+            Product::BrdfTable => "BRDF table",
+            Product::BrdfTableLookup => "BRDF table, bilinear lookup",
+            Product::Prefilter => "prefiltered cube",
+            Product::Irradiance => "irradiance",
+            Product::ShadedColour => "shaded colour",
+            Product::PrefilteredLookup => "prefiltered lookup, any roughness",
+        }
+    }
+}
+
+/// How it was made: the seed's method (splitsum's first bake), today's defaults, and the
+/// alternatives measured beside them.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// The seed: six linear mips, 1024 GGX samples at bias 0.5, the sampled table.
+    Seed,
+    /// `Settings::default()` and the default shading.
+    Defaults,
+    /// The defaults, reading along the mirror direction (no dominant direction).
+    MirrorDirection,
+    /// The defaults with multiple-scattering compensation.
+    MultipleScattering,
+    /// The defaults with filtered sampling of the lookup.
+    FilteredSampling,
+    /// The defaults with a Smith–Schlick table.
+    SmithSchlickTable,
+    /// SH9 in place of the irradiance convolution.
+    Sh9,
+    /// The split sum from exact ingredients: the error of the approximation itself.
+    ExactIngredients,
+}
+
+impl Method {
+    /// Its name in the report.
+    pub fn title(self) -> &'static str {
+        match self {
+            Method::Seed => "seed method",
+            Method::Defaults => "defaults",
+            Method::MirrorDirection => "defaults, mirror direction",
+            Method::MultipleScattering => "defaults + multiple scattering",
+            Method::FilteredSampling => "defaults + filtered sampling",
+            Method::SmithSchlickTable => "defaults, Smith-Schlick table",
+            Method::Sh9 => "SH9",
+            Method::ExactIngredients => "exact ingredients (split sum alone)",
+        }
+    }
+}
+
+/// Which part of the error a row holds (for the shaded colour: the total splits into
+/// the bake's, the split sum's and the shading model's shares).
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Part {
+    /// Against the truth.
+    Total,
+    /// (a) the baked products against exact ingredients.
+    Bake,
+    /// (b) the split sum from exact ingredients against the full integral of its model.
+    SplitSum,
+    /// (c) the model's masking (Smith–Schlick) against exact Smith.
+    Model,
+}
+
+/// The knob a row's series sweeps.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Knob {
+    /// Samples per texel (`samples`).
+    Samples,
+    /// The table's or the cube's size (`size`).
+    Size,
+    /// The prefilter's source-mip bias (`bias`).
+    Bias,
+    /// The source level summed (`source_size`).
+    SourceSize,
+    /// A whole quality level (`samples` holds its sample count).
+    Quality,
+    /// Nothing: one measurement.
+    None,
+}
+
+/// What the errors measure; both are relative.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Metric {
+    /// `|L(got) − L(want)| / L(want)`, `L` the luminance.
+    RelativeLuminance,
+    /// The BRDF table's directional albedo `F₀·A + B`, relative, the larger of `F₀ = 0.04`
+    /// and `F₀ = 1`.
+    RelativeAlbedo,
+}
+
+/// One measurement: a product made by a method on a backend, with the swept knob's value
+/// in its own column, its wall time and its errors.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Measurement {
+    /// What is measured.
+    pub product: Product,
+    /// How it was made.
+    pub method: Method,
+    /// Which part of the error.
+    pub part: Part,
+    /// The knob its series sweeps.
+    pub knob: Knob,
+    /// `gpu` or `cpu`; empty where nothing ran on a backend.
+    pub backend: String,
+    /// The backend's adapter and driver, or the CPU's threads.
+    pub device: String,
+    /// Samples per texel (of specular mip 1, for a bake).
+    pub samples: Option<u32>,
+    /// The table's or the cube's face size.
+    pub size: Option<u32>,
+    /// Face size of the source level summed.
+    pub source_size: Option<u32>,
+    /// Source-mip bias of the prefilter.
+    pub bias: Option<f32>,
+    /// Roughness band `[lo, hi)` of the points (or the level's roughness, `lo = hi`).
+    pub roughness_lo: Option<f32>,
+    /// Upper end of the roughness band.
+    pub roughness_hi: Option<f32>,
+    /// `n·v` band `(lo, hi]` of the shading points.
+    pub nv_lo: Option<f32>,
+    /// Upper end of the `n·v` band.
+    pub nv_hi: Option<f32>,
+    /// Lookups within 10° of the brightest texel (`true`), elsewhere (`false`), or all.
+    pub near_sun: Option<bool>,
+    /// Wall time of the bake or step in milliseconds (`None` for a row that shares a
+    /// bake's time with the row above it, or where nothing ran).
+    pub time_ms: Option<f64>,
+    /// Mean error.
+    pub mean_error: f64,
+    /// Largest error.
+    pub max_error: f64,
+    /// What the errors measure.
+    pub metric: Metric,
+}
+
+impl Measurement {
+    /// A row of `product` by `method` from its `errors` (their mean and largest), every
+    /// knob column empty: set them with struct update syntax.
+    pub fn of(product: Product, method: Method, errors: &[f64], metric: Metric) -> Self {
+        let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
+        let max_error = errors.iter().copied().fold(0.0, f64::max);
+        Self {
+            product,
+            method,
+            part: Part::Total,
+            knob: Knob::None,
+            backend: String::new(),
+            device: String::new(),
+            samples: None,
+            size: None,
+            source_size: None,
+            bias: None,
+            roughness_lo: None,
+            roughness_hi: None,
+            nv_lo: None,
+            nv_hi: None,
+            near_sun: None,
+            time_ms: None,
+            mean_error,
+            max_error,
+            metric,
+        }
+    }
+
+    /// The swept knob's value, as a number.
+    pub fn knob_value(&self) -> Option<f64> {
+        match self.knob {
+            Knob::Samples | Knob::Quality => self.samples.map(f64::from),
+            Knob::Size => self.size.map(f64::from),
+            Knob::Bias => self.bias.map(f64::from),
+            Knob::SourceSize => self.source_size.map(f64::from),
+            Knob::None => None,
+        }
+    }
+
+    /// What sets it apart in a table: the knobs that have values, in words.
+    pub fn setting(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(n) = self.samples {
+            parts.push(format!("{n} samples"));
+        }
+        if let Some(s) = self.size {
+            parts.push(format!("{s}x{s}"));
+        }
+        if let Some(s) = self.source_size {
+            parts.push(format!("{s}x{s} source"));
+        }
+        if let Some(b) = self.bias {
+            parts.push(format!("bias {b}"));
+        }
+        if parts.is_empty() { "-".into() } else { parts.join(", ") }
+    }
+}
+
+/// Reads `report.csv`'s rows.
+pub fn read_csv(text: &str) -> Result<Vec<Measurement>, csv::Error> {
+    csv::Reader::from_reader(text.as_bytes()).deserialize().collect()
+}
+
+/// Writes rows as `report.csv` does.
+pub fn write_csv<W: std::io::Write>(w: W, rows: &[Measurement]) -> Result<(), csv::Error> {
+    let mut out = csv::Writer::from_writer(w);
+    for r in rows {
+        out.serialize(r)?;
+    }
+    out.flush()?;
+    Ok(())
+}

@@ -1,0 +1,20 @@
+//! splitsum's integration tests, one module per subject, in one binary. `bash scripts/dev.sh
+//! test` runs them all, then the GPU subjects again on wgpu's GL backend
+//! (`cargo test --test suite -- prefilter:: lut:: …`).
+
+mod architecture;
+mod cli;
+mod equirect;
+mod files;
+mod fuzz;
+mod irradiance;
+mod library;
+mod lut;
+mod model;
+mod plan;
+mod portability;
+mod prefilter;
+mod render;
+mod report;
+mod stability;
+mod targets;
