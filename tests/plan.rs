@@ -31,6 +31,12 @@ fn material(name: &str, fields: &str) -> String {
     format!("[[materials]]\nname = {name:?}\n{fields}\n\n[[objects]]\nkind = \"sphere-grid\"\nmaterial = {name:?}\n")
 }
 
+/// A material on the glTF torus (a scene draws one sphere grid and one model).
+fn model(name: &str, fields: &str) -> String {
+    let torus = concat!(env!("CARGO_MANIFEST_DIR"), "/../display/assets/torus.glb");
+    format!("[[materials]]\nname = {name:?}\n{fields}\n\n[[objects]]\nkind = \"gltf\"\npath = {torus:?}\nmaterial = {name:?}\n")
+}
+
 /// The plan over a 256² environment of width 1024 (the vendored ones).
 fn planned(s: &Scene) -> Plan {
     plan::plan(s, 256, InputShape::Equirect { width: 1024, height: 512 }, &Calibration::default()).unwrap()
@@ -94,7 +100,7 @@ fn a_roughness_range_keeps_the_mips_around_it() {
     assert_eq!((p.job.size, p.job.levels.clone()), (32, vec![1, 2]));
     // Two materials: the union of their mips. r = 0.2 needs the 256² cube (M = 6, lod 1.90);
     // r = 0.85 and 0.9 read lod 4.69 and 4.80.
-    let two = format!("{}{}", material("a", "roughness = 0.2"), material("b", "roughness = [0.85, 0.9]"));
+    let two = format!("{}{}", material("a", "roughness = 0.2"), model("b", "roughness = [0.85, 0.9]"));
     assert_eq!(planned(&scene("", &two)).job.levels, vec![1, 2, 4, 5]);
 }
 
@@ -106,8 +112,26 @@ fn phong_and_blinn_phong_need_no_ggx_table() {
         assert!(skipped(&p, "BRDF table"));
     }
     // One Cook–Torrance material among them brings it back.
-    let two = format!("{}{}", material("a", "specular = \"phong\""), material("b", "specular = \"cook-torrance\""));
+    let two = format!("{}{}", material("a", "specular = \"phong\""), model("b", "specular = \"cook-torrance\""));
     assert!(planned(&scene("", &two)).job.products.lut);
+}
+
+#[test]
+fn a_scene_draws_every_object_or_is_refused() {
+    // Two grids, or two models, cannot all be drawn: refused by the field, not drawn in part.
+    let env = support::environment_path("courtyard");
+    for two in [format!("{}{}", material("a", ""), material("b", "")), format!("{}{}", model("a", ""), model("b", ""))] {
+        let text = format!("environment = {:?}\n{two}", env.display().to_string());
+        let e = Scene::parse(&text).expect_err("refused").to_string();
+        assert!(e.contains("[[objects]] lists 2 objects") && e.contains("one sphere grid and one glTF model"), "{e}");
+    }
+    // A grid and a model, each with its own material and options.
+    let s = scene("", &format!("{}{}", material("a", "specular = \"phong\""), model("b", "roughness = 0.5")));
+    let view = s.view(1.0);
+    let m = s.model().unwrap().expect("the model");
+    assert!(view.spheres && view.show_model);
+    assert_eq!(view.options.specular, splitsum_shaders::shade::SpecularModel::Phong as u32);
+    assert!(m.primitives.iter().all(|p| p.material.options.specular == splitsum_shaders::shade::SpecularModel::CookTorrance as u32));
 }
 
 #[test]
@@ -214,15 +238,7 @@ fn render(s: &Scene, env: &BakedEnvironment, backend: &Backend) -> Vec<Vec4> {
     let mut frame = view.frame(env.shape(), 96, 54, true);
     frame.flags |= Frame::LINEAR;
     let model = s.model().unwrap();
-    match (backend, &model) {
-        (Backend::Cpu, Some(m)) => splitsum_display::raster::render(env, &frame, m),
-        (Backend::Cpu, None) => splitsum_display::render::render_cpu(env, &frame),
-        (Backend::Gpu(g), m) => {
-            let scene = splitsum_display::render::GpuScene::new(g, env);
-            let gm = m.as_ref().map(|m| splitsum_display::render::GpuModel::new(g, &scene, m));
-            scene.render_offscreen(g, &frame, gm.as_ref()).unwrap()
-        }
-    }
+    splitsum_display::render::render(backend, env, &frame, model.as_ref()).unwrap()
 }
 
 fn max_abs(a: &[Vec4], b: &[Vec4]) -> f32 {

@@ -94,3 +94,29 @@ fn shading_options_gpu_match_the_cpu_reference() {
     let bound = frame_bound();
     assert!(worst_all < bound, "{worst_all:e} (bound {bound:e})");
 }
+
+/// The frame's projection (glam's right-handed, depth in [0, 1]) against its closed form:
+/// a point on the view axis at the near plane has depth 0, at the far plane 1; a point on
+/// the top edge of the field of view maps to y = +1 (wgpu's NDC is y-up), one on the right
+/// edge to x = +1; and the eye's ray through a pixel centre (`Frame::forward`, `right`,
+/// `up`, `tan_half_fov`, as the ray-cast scene builds it) projects back onto that pixel.
+#[test]
+fn the_projection_is_right_handed_with_depth_zero_to_one() {
+    use splitsum_shaders::glam::Vec3;
+    let state = ViewState { pitch: 0.3, yaw: 0.7, ..ViewState::default() };
+    let (w, h) = (320u32, 200u32);
+    let f = state.frame(bytemuck::Zeroable::zeroed(), w, h, true);
+    let (eye, fwd, right, up) = (f.eye.truncate(), f.forward.truncate(), f.right.truncate(), f.up.truncate());
+    let ndc = |p: Vec3| {
+        let c = f.view_proj * p.extend(1.0);
+        c.truncate() / c.w
+    };
+    let tol = 1e-4;
+    assert!(ndc(eye + fwd * f.near).z.abs() < tol, "near → 0");
+    assert!((ndc(eye + fwd * f.far).z - 1.0).abs() < tol, "far → 1");
+    let top = ndc(eye + (fwd + up * f.tan_half_fov) * 10.0);
+    assert!((top.y - 1.0).abs() < tol && top.x.abs() < tol, "top edge: {top}");
+    let aspect = w as f32 / h as f32;
+    let side = ndc(eye + (fwd + right * f.tan_half_fov * aspect) * 10.0);
+    assert!((side.x - 1.0).abs() < tol && side.y.abs() < tol, "right edge: {side}");
+}

@@ -3,6 +3,7 @@
 //! (`cargo test --test suite -- prefilter:: lut:: …`).
 
 mod architecture;
+mod choices;
 mod cli;
 mod equirect;
 mod files;

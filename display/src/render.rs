@@ -2,13 +2,14 @@
 //! block it becomes, the GPU renderer (the `display` shaders on a window or an offscreen
 //! texture) and the CPU reference renderer (the same `scene::pixel`, per pixel, with rayon).
 
-use crate::model::{Model, SLOTS, Texture, Vertex};
+use crate::model::{Model, Texture, Vertex};
 use rayon::prelude::*;
-use splitsum::backend::gpu::{Gpu, group_layout};
+use splitsum::backend::gpu::{Gpu, group_entries, group_layout};
 use splitsum::bake::BakedEnvironment;
 use splitsum::error::{Error, Result};
 use splitsum_shaders::choice::Choice;
-use splitsum_shaders::glam::{Mat4, Vec2, Vec3, Vec4};
+use splitsum_shaders::glam::camera::rh;
+use splitsum_shaders::glam::{Vec2, Vec3, Vec4};
 use splitsum_shaders::scene::{self, Frame, Light, MAX_LIGHTS};
 use splitsum_shaders::shade::{DiffuseModel, EnvironmentShape, FresnelForm, ShadeOptions, SpecularModel};
 use splitsum_shaders::tonemap::Tonemapper;
@@ -172,10 +173,27 @@ impl ViewState {
             shape,
             base_color: self.base_color.extend(1.0),
             lights,
-            view_proj: perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * look_at(eye, forward, right, up),
+            // Right-handed, depth in [0, 1] (`surface::depth` assumes it): view-space
+            // `z = −near` maps to 0 and `−far` to 1.
+            view_proj: rh::proj::directx::perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * rh::view::look_to_mat4(eye, forward, up),
             grid_ranges: self.grid_ranges,
         }
     }
+}
+
+/// The one render path: `frame` (with `model`, if any) on `backend`, as linear RGBA, row
+/// 0 at the top. On the GPU, the renderer's passes; on the CPU, the reference renderers
+/// (`raster` with a model, the ray-cast scene without), which the GPU is tested against.
+pub fn render(backend: &splitsum::Backend, env: &BakedEnvironment, frame: &Frame, model: Option<&Model>) -> Result<Vec<Vec4>> {
+    Ok(match (backend, model) {
+        (splitsum::Backend::Gpu(g), m) => {
+            let scene = GpuScene::new(g, env);
+            let gm = m.map(|m| GpuModel::new(g, &scene, m));
+            scene.render_offscreen(g, frame, gm.as_ref())?
+        }
+        (splitsum::Backend::Cpu, Some(m)) => crate::raster::render(env, frame, m),
+        (splitsum::Backend::Cpu, None) => render_cpu(env, frame),
+    })
 }
 
 /// The CPU reference renderer: `scene::pixel` at every pixel centre, row 0 at the top.
@@ -225,13 +243,19 @@ impl GpuScene {
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: frame_buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: specular.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: irradiance.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: lut.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: source.as_entire_binding() },
-            ],
+            // In the order of `splitsum_shaders::display`'s group 1: frame, specular,
+            // irradiance, table, source.
+            entries: &group_entries(
+                &DISPLAY,
+                1,
+                vec![
+                    frame_buffer.as_entire_binding(),
+                    specular.as_entire_binding(),
+                    irradiance.as_entire_binding(),
+                    lut.as_entire_binding(),
+                    source.as_entire_binding(),
+                ],
+            ),
         });
         Self { layout, pipeline_layout, pipelines: Default::default(), frame_buffer, bind_group, shape: env.shape() }
     }
@@ -402,24 +426,6 @@ impl GpuScene {
     }
 }
 
-/// Right-handed perspective projection with depth in [0, 1]: view-space `z = −near` maps
-/// to 0 and `−far` to 1 (the projection `surface::depth` assumes).
-pub fn perspective(fov_y: f32, aspect: f32, near: f32, far: f32) -> Mat4 {
-    let h = 1.0 / (0.5 * fov_y).tan();
-    let r = far / (near - far);
-    Mat4::from_cols(Vec4::new(h / aspect, 0.0, 0.0, 0.0), Vec4::new(0.0, h, 0.0, 0.0), Vec4::new(0.0, 0.0, r, -1.0), Vec4::new(0.0, 0.0, r * near, 0.0))
-}
-
-/// World to view space for a camera at `eye` with orthonormal `forward`, `right`, `up`.
-pub fn look_at(eye: Vec3, forward: Vec3, right: Vec3, up: Vec3) -> Mat4 {
-    Mat4::from_cols(
-        Vec4::new(right.x, up.x, -forward.x, 0.0),
-        Vec4::new(right.y, up.y, -forward.y, 0.0),
-        Vec4::new(right.z, up.z, -forward.z, 0.0),
-        Vec4::new(-right.dot(eye), -up.dot(eye), forward.dot(eye), 1.0),
-    )
-}
-
 /// Depth buffer format of the display.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
@@ -472,12 +478,13 @@ impl GpuModel {
                     usage: wgpu::BufferUsages::UNIFORM,
                 });
                 let views: Vec<wgpu::TextureView> = p.textures.iter().map(|t| upload_texture(gpu, t.as_ref().unwrap_or(&white))).collect();
-                let mut group = vec![wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }];
-                for (k, v) in views.iter().enumerate() {
-                    group.push(wgpu::BindGroupEntry { binding: k as u32 + 1, resource: wgpu::BindingResource::TextureView(v) });
-                }
-                group.push(wgpu::BindGroupEntry { binding: SLOTS as u32 + 1, resource: wgpu::BindingResource::Sampler(&sampler) });
-                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("mesh"), layout: &layout, entries: &group });
+                // Group 2 in binding order: the material, its texture slots, the sampler.
+                let resources = std::iter::once(uniform.as_entire_binding())
+                    .chain(views.iter().map(wgpu::BindingResource::TextureView))
+                    .chain(std::iter::once(wgpu::BindingResource::Sampler(&sampler)))
+                    .collect();
+                let entries = group_entries(&DISPLAY, 2, resources);
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("mesh"), layout: &layout, entries: &entries });
                 GpuPrimitive {
                     vertices: gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                         label: Some("vertices"),

@@ -118,19 +118,26 @@ pub struct MaterialSpec {
 
 /// The shading options a user chooses beside the models, with their defaults: the
 /// prefiltered cube read along the dominant direction, single scattering, no filtered
-/// sampling, the exact Smith term for direct lights. The one place their flags are made.
+/// sampling, the exact Smith term for direct lights. The one place their flags are made,
+/// and (with the `cli` feature) the command line's flags themselves; a scene file spells
+/// them as fields of its materials.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "cli", derive(clap::Args))]
 pub struct ShadingChoices {
     /// Read the prefiltered cube along the mirror direction (the seed's choice) instead of
     /// the specular dominant direction.
+    #[cfg_attr(feature = "cli", arg(long))]
     pub mirror_direction: bool,
     /// Multiple-scattering energy compensation of the image-based specular (Fdez-Agüera 2019).
+    #[cfg_attr(feature = "cli", arg(long))]
     pub multiscatter: bool,
     /// Quality mode: filtered importance sampling at shading time below mip 1's roughness.
+    #[cfg_attr(feature = "cli", arg(long))]
     pub filtered: bool,
     /// Smith–Schlick (UE4's `k = (r+1)²/8`) for direct lights instead of the exact
     /// height-correlated Smith term (the image-based light follows the table's own model,
     /// `--lut-masking`).
+    #[cfg_attr(feature = "cli", arg(long))]
     pub smith_schlick: bool,
 }
 
@@ -395,6 +402,17 @@ impl Scene {
                 return bad(format!("an object uses material {:?}, which no [[materials]] entry defines", o.material()));
             }
         }
+        // The display draws one sphere grid and one glTF model, each with its own material;
+        // a scene that lists more is refused rather than drawn in part.
+        let grids = self.objects.iter().filter(|o| matches!(o, ObjectSpec::SphereGrid { .. })).count();
+        let models = self.objects.iter().filter(|o| matches!(o, ObjectSpec::Gltf { .. })).count();
+        for (n, kind) in [(grids, "sphere-grid"), (models, "gltf")] {
+            if n > 1 {
+                return bad(format!(
+                    "[[objects]] lists {n} objects of kind {kind:?}; the display draws one sphere grid and one glTF model a scene, each with its own material: give the others scenes of their own"
+                ));
+            }
+        }
         if self.output.width == 0 || self.output.height == 0 || self.output.width > 8192 || self.output.height > 8192 {
             return bad(format!("[output] must be 1..8192 pixels each way, not {}×{}", self.output.width, self.output.height));
         }
@@ -450,8 +468,8 @@ impl Scene {
 }
 
 impl Scene {
-    /// The view of this scene: camera, direct lights, the sphere grid (the first
-    /// `sphere-grid` object) with its material, exposure and tone curve.
+    /// The view of this scene: camera, direct lights, its sphere grid (a scene has at most
+    /// one, `check`) with its material, exposure and tone curve.
     pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
         use splitsum_shaders::glam::{Vec3, Vec4};
         let grid = self.objects.iter().find_map(|o| match o {
@@ -506,8 +524,8 @@ impl Scene {
         v
     }
 
-    /// The first glTF object's model, with its material's models and ranges, placed beside
-    /// the grid (or where the camera frames it alone).
+    /// The scene's glTF model (at most one, `check`), with its material's models and
+    /// ranges, placed beside the grid (or where the camera frames it alone).
     pub fn model(&self) -> Result<Option<crate::model::Model>> {
         let Some((path, material)) = self.objects.iter().find_map(|o| match o {
             ObjectSpec::Gltf { path, material } => Some((path, self.material(material))),

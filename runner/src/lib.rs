@@ -10,7 +10,7 @@ pub mod cli;
 
 // The crates the subcommands call, under short names.
 use splitsum::{Backend, BackendKind, Error, bake, cache, cost, environment, files, ktx2, output, progress, settings};
-use splitsum_display::{model, plan, prepare, raster, render, scene, view};
+use splitsum_display::{model, plan, prepare, render, scene, view};
 use splitsum_report::report;
 
 /// Logs warnings and errors to stderr (`RUST_LOG` chooses otherwise): wgpu's and the

@@ -33,20 +33,41 @@ pub trait Choice: Copy + PartialEq + 'static {
     }
 }
 
-/// Implements [`Choice`] for a fieldless enum: its variants in code order, each with its
-/// name.
+/// Implements [`Choice`] for a fieldless `#[repr(u32)]` enum: its variants in code order,
+/// each with its name; and `from_u32`, the decoder the shaders read parameter blocks with
+/// (unknown codes give the first variant), which [`Choice::from_code`] is too.
 #[macro_export]
 macro_rules! choice {
-    ($t:ty: $($v:ident => $n:literal),+ $(,)?) => {
+    ($t:ty: $first:ident => $first_name:literal $(, $v:ident => $n:literal)* $(,)?) => {
+        impl $t {
+            /// The choice whose `u32` code is `code`, as parameter blocks carry it;
+            /// unknown codes give the first choice. (A chain of comparisons, which
+            /// rust-gpu compiles: no table, no early return.)
+            #[inline]
+            pub fn from_u32(code: u32) -> Self {
+                #[allow(unused_mut)]
+                let mut choice = <$t>::$first;
+                $(
+                    if code == <$t>::$v as u32 {
+                        choice = <$t>::$v;
+                    }
+                )*
+                choice
+            }
+        }
         impl $crate::choice::Choice for $t {
-            const ALL: &'static [Self] = &[$(<$t>::$v),+];
+            const ALL: &'static [Self] = &[<$t>::$first $(, <$t>::$v)*];
             fn name(self) -> &'static str {
                 match self {
-                    $(<$t>::$v => $n,)+
+                    <$t>::$first => $first_name,
+                    $(<$t>::$v => $n,)*
                 }
             }
             fn code(self) -> u32 {
                 self as u32
+            }
+            fn from_code(code: u32) -> Self {
+                <$t>::from_u32(code)
             }
         }
     };

@@ -48,20 +48,6 @@ pub enum Facing {
 }
 
 impl Facing {
-    /// The facing encoded as `u32` in kernel parameters; unknown codes are `NegZ`.
-    #[inline]
-    pub fn from_u32(code: u32) -> Self {
-        if code == 1 {
-            Self::PosX
-        } else if code == 2 {
-            Self::PosZ
-        } else if code == 3 {
-            Self::NegX
-        } else {
-            Self::NegZ
-        }
-    }
-
     /// The direction, in splitsum's image convention ([`dir_to_uv`]), that a cube with
     /// this facing shows at cube direction `d`: the inverse turn about `+Y`.
     #[inline]

@@ -249,30 +249,55 @@ macro_rules! kahan {
     }};
 }
 
+/// What a [`Compensated`] sum adds: `f32`, or `Vec4` for four channels at once.
+pub trait Summand: Copy + core::ops::Add<Output = Self> + core::ops::Sub<Output = Self> {
+    /// Zero.
+    const ZERO: Self;
+}
+
+impl Summand for f32 {
+    const ZERO: Self = 0.0;
+}
+
+impl Summand for Vec4 {
+    const ZERO: Self = Vec4::ZERO;
+}
+
 /// Summation of 2²⁴ and more f32 terms without the O(N·ε) drift of naive accumulation:
 /// Kahan-compensated sums of blocks of [`SUM_BLOCK`] terms, themselves added with Kahan's
 /// compensation (Kahan 1965; Higham, *Accuracy and Stability of Numerical Algorithms*
 /// §4.3–4.4). The blocks matter where a GPU compiler reassociates the compensation away
 /// (Mesa's lavapipe does): what is left is then a blocked sum with error O((B + N/B)·ε)
 /// instead of O(N·ε). Branch-light, no arrays: cheap in registers.
-#[derive(Copy, Clone, Default)]
-pub struct CompensatedSum {
-    block: f32,
-    block_carry: f32,
+#[derive(Copy, Clone)]
+pub struct Compensated<T: Summand> {
+    block: T,
+    block_carry: T,
     count: u32,
-    sum: f32,
-    carry: f32,
+    sum: T,
+    carry: T,
 }
 
-impl CompensatedSum {
+/// A compensated sum of scalars.
+pub type CompensatedSum = Compensated<f32>;
+/// A compensated sum of four channels at once.
+pub type CompensatedSum4 = Compensated<Vec4>;
+
+impl<T: Summand> Default for Compensated<T> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<T: Summand> Compensated<T> {
     /// An empty sum.
     pub fn new() -> Self {
-        Self { block: 0.0, block_carry: 0.0, count: 0, sum: 0.0, carry: 0.0 }
+        Self { block: T::ZERO, block_carry: T::ZERO, count: 0, sum: T::ZERO, carry: T::ZERO }
     }
 
     /// Adds `x`.
     #[inline]
-    pub fn add(&mut self, x: f32) {
+    pub fn add(&mut self, x: T) {
         kahan!(self.block, self.block_carry, x);
         self.count += 1;
         if self.count == SUM_BLOCK {
@@ -283,14 +308,14 @@ impl CompensatedSum {
     #[inline]
     fn flush(&mut self) {
         kahan!(self.sum, self.carry, self.block);
-        self.block = 0.0;
-        self.block_carry = 0.0;
+        self.block = T::ZERO;
+        self.block_carry = T::ZERO;
         self.count = 0;
     }
 
     /// The compensated total.
     #[inline]
-    pub fn total(&self) -> f32 {
+    pub fn total(&self) -> T {
         let mut s = *self;
         s.flush();
         s.sum
@@ -298,70 +323,13 @@ impl CompensatedSum {
 
     /// A sum that continues from `parts()` of an earlier one (a previous chunk).
     #[inline]
-    pub fn resume(sum: f32, carry: f32) -> Self {
-        Self { block: 0.0, block_carry: 0.0, count: 0, sum, carry }
+    pub fn resume(sum: T, carry: T) -> Self {
+        Self { block: T::ZERO, block_carry: T::ZERO, count: 0, sum, carry }
     }
 
     /// `(sum, carry)` after flushing the current block: all a later chunk needs.
     #[inline]
-    pub fn parts(&self) -> (f32, f32) {
-        let mut s = *self;
-        s.flush();
-        (s.sum, s.carry)
-    }
-}
-
-/// [`CompensatedSum`] for four channels at once.
-#[derive(Copy, Clone, Default)]
-pub struct CompensatedSum4 {
-    block: Vec4,
-    block_carry: Vec4,
-    count: u32,
-    sum: Vec4,
-    carry: Vec4,
-}
-
-impl CompensatedSum4 {
-    /// An empty sum.
-    pub fn new() -> Self {
-        Self { block: Vec4::ZERO, block_carry: Vec4::ZERO, count: 0, sum: Vec4::ZERO, carry: Vec4::ZERO }
-    }
-
-    /// Adds `x`.
-    #[inline]
-    pub fn add(&mut self, x: Vec4) {
-        kahan!(self.block, self.block_carry, x);
-        self.count += 1;
-        if self.count == SUM_BLOCK {
-            self.flush();
-        }
-    }
-
-    #[inline]
-    fn flush(&mut self) {
-        kahan!(self.sum, self.carry, self.block);
-        self.block = Vec4::ZERO;
-        self.block_carry = Vec4::ZERO;
-        self.count = 0;
-    }
-
-    /// The compensated total.
-    #[inline]
-    pub fn total(&self) -> Vec4 {
-        let mut s = *self;
-        s.flush();
-        s.sum
-    }
-
-    /// A sum that continues from `parts()` of an earlier one (a previous chunk).
-    #[inline]
-    pub fn resume(sum: Vec4, carry: Vec4) -> Self {
-        Self { block: Vec4::ZERO, block_carry: Vec4::ZERO, count: 0, sum, carry }
-    }
-
-    /// `(sum, carry)` after flushing the current block.
-    #[inline]
-    pub fn parts(&self) -> (Vec4, Vec4) {
+    pub fn parts(&self) -> (T, T) {
         let mut s = *self;
         s.flush();
         (s.sum, s.carry)

@@ -52,19 +52,6 @@ pub enum RoughnessMapping {
 }
 
 impl RoughnessMapping {
-    /// The mapping encoded as `u32` in kernel parameters; unknown codes are linear.
-    pub fn from_u32(code: u32) -> Self {
-        if code == 1 {
-            Self::Quadratic
-        } else if code == 2 {
-            Self::Geometric
-        } else if code == 3 {
-            Self::Filament
-        } else {
-            Self::Linear
-        }
-    }
-
     /// Roughness of mip `mip` out of `mips`.
     #[inline]
     pub fn roughness(self, mip: u32, mips: u32) -> f32 {

@@ -23,16 +23,6 @@ pub enum Tonemapper {
     Clamp = 2,
 }
 
-impl Tonemapper {
-    /// From its `u32` code; unknown codes are ACES.
-    pub fn from_u32(code: u32) -> Self {
-        match code {
-            1 => Self::Reinhard,
-            2 => Self::Clamp,
-            _ => Self::Aces,
-        }
-    }
-}
 
 /// Rec. 709 relative luminance.
 #[inline]

@@ -25,38 +25,27 @@ pub struct Timing {
     pub seconds: f64,
 }
 
-/// The products as a backend made them (`T`: host texels, or device buffers).
-pub struct Made<T> {
-    /// The source cube with its full mip chain.
-    pub source: T,
+/// The products of a bake: as a backend made them (`Made<K::Texels>`: host texels, or
+/// device buffers), or read into host memory ([`Baked`]). Each is present where the job
+/// asked for it.
+pub struct Made<C, L = C> {
+    /// The source cube with its mips (always made; absent where a bake read textures back
+    /// and nothing kept it).
+    pub source: Option<C>,
     /// The specular cube (`Job::specular_layout`).
-    pub specular: Option<T>,
+    pub specular: Option<C>,
     /// The irradiance cube (`E/π`).
-    pub irradiance: Option<T>,
+    pub irradiance: Option<C>,
     /// SH9 radiance coefficients.
     pub sh9: Option<Sh9>,
-    /// The BRDF table, `(A, B, 0, 0)` per texel.
-    pub lut: Option<T>,
+    /// The BRDF table, `(A, B, 0, 0)` per texel on a backend.
+    pub lut: Option<L>,
     /// Wall time of each step.
     pub timings: Vec<Timing>,
 }
 
 /// The results of a bake, in host memory.
-pub struct Baked {
-    /// The source cube with its mips (absent where the bake read textures back and
-    /// nothing kept it).
-    pub source: Option<Cube>,
-    /// The specular cube.
-    pub specular: Option<Cube>,
-    /// The irradiance cube (`E/π`).
-    pub irradiance: Option<Cube>,
-    /// SH9 radiance coefficients.
-    pub sh9: Option<Sh9>,
-    /// The BRDF table.
-    pub lut: Option<Lut>,
-    /// Wall time of each step.
-    pub timings: Vec<Timing>,
-}
+pub type Baked = Made<Cube, Lut>;
 
 /// Runs `step` on `k`, estimated at `estimates` (see [`step_estimates`]), with its
 /// progress shown, and records its wall time (until the backend has finished it).
@@ -161,7 +150,7 @@ pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout,
     } else {
         None
     };
-    Ok(Made { source, specular, irradiance, sh9, lut, timings })
+    Ok(Made { source: Some(source), specular, irradiance, sh9, lut, timings })
 }
 
 /// Bakes `job` from `env` on backend `k`, leaving the products there.
@@ -176,7 +165,7 @@ pub fn make<K: Kernels>(k: &K, gpu: bool, env: &Environment, job: &Job) -> Resul
 pub fn read<K: Kernels>(k: &K, made: Made<K::Texels>, job: &Job) -> Result<Baked> {
     let cube = |layout: CubeLayout, t: &K::Texels| -> Result<Cube> { Ok(Cube { layout, texels: k.read(t)? }) };
     Ok(Baked {
-        source: Some(cube(job.source_layout(), &made.source)?),
+        source: made.source.as_ref().map(|t| cube(job.source_layout(), t)).transpose()?,
         specular: made.specular.as_ref().map(|t| cube(job.specular_layout(), t)).transpose()?,
         irradiance: made.irradiance.as_ref().map(|t| cube(job.irradiance_layout(), t)).transpose()?,
         sh9: made.sh9,
@@ -233,21 +222,10 @@ pub struct BakedEnvironment {
 }
 
 impl BakedEnvironment {
-    /// An exposure at which a white Lambert surface shows, on average, at 0.5 before the
-    /// tone curve: `0.5 / mean(E/π)`. The mean of `E/π` over all normals is the
-    /// solid-angle-weighted mean of the radiance (`∫ max(0, n·l) dn = π` for every `l`), so
-    /// it is read from the source cube and does not depend on which products a plan bakes.
+    /// The display's exposure for this environment (`preview::auto_exposure`, the one
+    /// rule: a white Lambert surface at 0.5 on average before the tone curve).
     pub fn auto_exposure(&self) -> f32 {
-        let s = self.source.layout.size;
-        let (mut sum, mut weight) = (0.0f64, 0.0f64);
-        for (i, c) in self.source.level(0).iter().enumerate() {
-            let (x, y) = (i as u32 % s, (i as u32 / s) % s);
-            let w = splitsum_shaders::cubemap::texel_solid_angle(x, y, s) as f64;
-            sum += w * splitsum_shaders::tonemap::luminance(c.truncate()) as f64;
-            weight += w;
-        }
-        let mean = sum / weight.max(f64::MIN_POSITIVE);
-        if mean > 0.0 { (0.5 / mean) as f32 } else { 1.0 }
+        crate::preview::auto_exposure(&self.source)
     }
 
     /// The shapes the shaders need.

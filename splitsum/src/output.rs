@@ -191,7 +191,7 @@ pub fn write_into(dir: &Path, name: &str, baked: &Baked, job: &Job, about: About
     };
     // Previews at the source's exposure (the specular cube's mip 0 where no source was kept).
     let sky = baked.source.as_ref().or(baked.specular.as_ref());
-    let exposure = sky.map_or(1.0, |c| preview::auto_exposure(c.level(0)));
+    let exposure = sky.map_or(1.0, preview::auto_exposure);
     let save_png = |name: &str, pic: &preview::Picture| -> Result<()> {
         files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
     };

@@ -33,13 +33,21 @@ impl Picture {
     }
 }
 
-/// Exposure mapping the log-average luminance of `texels` to middle grey.
-pub fn auto_exposure(texels: &[Vec4]) -> f32 {
-    if texels.is_empty() {
-        return 1.0;
+/// The one automatic exposure, of the display and the previews alike: a white Lambert
+/// surface shows, on average, at 0.5 before the tone curve, `0.5 / mean(E/π)`. The mean of
+/// `E/π` over all normals is the solid-angle-weighted mean of the radiance
+/// (`∫ max(0, n·l) dn = π` for every `l`), read from level 0 of `cube`.
+pub fn auto_exposure(cube: &Cube) -> f32 {
+    let s = cube.layout.size;
+    let (mut sum, mut weight) = (0.0f64, 0.0f64);
+    for (i, c) in cube.level(0).iter().enumerate() {
+        let (x, y) = (i as u32 % s, (i as u32 / s) % s);
+        let w = splitsum_shaders::cubemap::texel_solid_angle(x, y, s) as f64;
+        sum += w * tonemap::luminance(c.truncate()) as f64;
+        weight += w;
     }
-    let sum: f64 = texels.iter().map(|t| ((tonemap::luminance(t.truncate()) as f64) + 1e-4).ln()).sum();
-    tonemap::key_exposure((sum / texels.len() as f64).exp() as f32)
+    let mean = sum / weight.max(f64::MIN_POSITIVE);
+    if mean > 0.0 && mean.is_finite() { (0.5 / mean) as f32 } else { 1.0 }
 }
 
 /// Where each face goes in a 4×3 cross, in face order +X, −X, +Y, −Y, +Z, −Z.

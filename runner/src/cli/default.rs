@@ -51,13 +51,7 @@ pub(super) fn default_run() -> anyhow::Result<()> {
     let (w, h) = (960, 540);
     let out = PathBuf::from("splitsum.png");
     files::check_output_file(&out, files::FileKind::Png, "the picture")?;
-    let pixels = match &backend {
-        Backend::Gpu(g) => {
-            let scene = crate::render::GpuScene::new(g, &baked);
-            scene.render_offscreen(g, &state.frame(scene.shape, w, h, true), None)?
-        }
-        Backend::Cpu => crate::render::render_cpu(&baked, &state.frame(baked.shape(), w, h, true)),
-    };
+    let pixels = crate::render::render(&backend, &baked, &state.frame(baked.shape(), w, h, true), None)?;
     files::write_png(&out, w, h, &crate::render::to_rgb8(&pixels))?;
     let shown = std::fs::canonicalize(&out).unwrap_or(out);
     println!("no display here: rendered the sphere grid ({w}×{h}) to {}", shown.display());

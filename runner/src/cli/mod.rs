@@ -147,14 +147,14 @@ pub struct LookArgs {
     #[arg(long)]
     pub no_grid: bool,
     #[command(flatten)]
-    pub shading: ShadingFlags,
+    pub shading: crate::scene::ShadingChoices,
 }
 
 impl LookArgs {
     /// The view these flags describe, with `auto_exposure` from the environment.
     pub fn view(&self, auto_exposure: f32) -> crate::render::ViewState {
         use splitsum_shaders::shade::ShadeOptions;
-        let flags = self.shading.choices().flags(!self.no_ibl, !self.no_lights);
+        let flags = self.shading.flags(!self.no_ibl, !self.no_lights);
         let mut view = crate::render::ViewState {
             spheres: !self.no_grid,
             show_model: !self.no_model,
@@ -315,38 +315,6 @@ static DISPLAY: std::sync::LazyLock<Settings> = std::sync::LazyLock::new(|| Sett
 pub(crate) fn choice<T: Choice + Send + Sync>() -> impl clap::builder::TypedValueParser<Value = T> {
     use clap::builder::TypedValueParser;
     clap::builder::PossibleValuesParser::new(T::ALL.iter().map(|c| c.name())).map(|name| T::from_name(&name).expect("clap accepts only the listed names"))
-}
-
-/// The shading options beside the models (`scene::ShadingChoices`), as flags.
-#[derive(Args, Clone, Copy, Debug, Default)]
-pub struct ShadingFlags {
-    /// Read the prefiltered cube along the mirror direction (the seed's choice) instead of
-    /// the specular dominant direction.
-    #[arg(long)]
-    pub mirror_direction: bool,
-    /// Multiple-scattering energy compensation of the image-based specular (Fdez-Agüera 2019).
-    #[arg(long)]
-    pub multiscatter: bool,
-    /// Quality mode: filtered importance sampling at shading time below mip 1's roughness.
-    #[arg(long)]
-    pub filtered: bool,
-    /// Smith–Schlick (UE4's `k = (r+1)²/8`) for direct lights instead of the exact
-    /// height-correlated Smith term (the image-based light follows the table's own model,
-    /// `--lut-masking`).
-    #[arg(long)]
-    pub smith_schlick: bool,
-}
-
-impl ShadingFlags {
-    /// The choices these flags make.
-    pub fn choices(&self) -> crate::scene::ShadingChoices {
-        crate::scene::ShadingChoices {
-            mirror_direction: self.mirror_direction,
-            multiscatter: self.multiscatter,
-            filtered: self.filtered,
-            smith_schlick: self.smith_schlick,
-        }
-    }
 }
 
 /// The flag that sets `field` (bake, bench and the display's quality flags), for messages
@@ -539,21 +507,3 @@ pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyho
     }
 }
 
-/// Renders `frame` (with `model`, if any) on `backend`: the GPU renderer, or the CPU
-/// reference renderer.
-fn render_frame(
-    backend: &Backend,
-    env: &crate::bake::BakedEnvironment,
-    frame: &splitsum_shaders::scene::Frame,
-    model: Option<&crate::model::Model>,
-) -> anyhow::Result<Vec<splitsum_shaders::glam::Vec4>> {
-    Ok(match (backend, model) {
-        (Backend::Gpu(g), m) => {
-            let scene = crate::render::GpuScene::new(g, env);
-            let gm = m.map(|m| crate::render::GpuModel::new(g, &scene, m));
-            scene.render_offscreen(g, frame, gm.as_ref())?
-        }
-        (Backend::Cpu, Some(m)) => crate::raster::render(env, frame, m),
-        (Backend::Cpu, None) => crate::render::render_cpu(env, frame),
-    })
-}

@@ -43,7 +43,7 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
         let start = Instant::now();
         let pixels = {
             let _step = crate::progress::step(&format!("rendering {w}×{h}"), None);
-            render_frame(&backend, &sb.env, &view.frame(sb.env.shape(), w, h, true), model.as_ref())?
+            crate::render::render(&backend, &sb.env, &view.frame(sb.env.shape(), w, h, true), model.as_ref())?
         };
         files::write_rgb8(&args.out, w, h, &crate::render::to_rgb8(&pixels), format)?;
         println!("rendered {w}×{h} in {:.3} s: {}", start.elapsed().as_secs_f64(), view.summary());
@@ -68,7 +68,7 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
     let frame = view.frame(baked.shape(), args.width, args.height, true);
     let pixels = {
         let _step = crate::progress::step(&format!("rendering {}×{}", args.width, args.height), None);
-        render_frame(&backend, &baked, &frame, model.as_ref())?
+        crate::render::render(&backend, &baked, &frame, model.as_ref())?
     };
     let render_secs = start.elapsed().as_secs_f64();
     files::write_rgb8(&args.out, args.width, args.height, &crate::render::to_rgb8(&pixels), format)?;

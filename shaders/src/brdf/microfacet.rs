@@ -86,12 +86,6 @@ pub enum Masking {
     SmithCorrelated = 1,
 }
 
-impl Masking {
-    /// The model encoded as `u32` in kernel parameters; unknown codes are Smith–Schlick.
-    pub fn from_u32(code: u32) -> Self {
-        if code == 1 { Self::SmithCorrelated } else { Self::SmithSchlick }
-    }
-}
 
 /// The height-correlated Smith visibility of GGX, `V = G₂ / (4 (n·l)(n·v))`, with
 /// `G₂ = 1 / (1 + Λ(v) + Λ(l))` and `Λ(x) = (√(1 + α² tan²θₓ) − 1)/2` (Heitz 2014, eq. 99),

@@ -104,6 +104,15 @@ pub fn group_layout(entries: &[&EntryPoint], group: u32) -> Vec<wgpu::BindGroupL
     out
 }
 
+/// The bind group entries of `group` for `entries`: `resources` in the order of the
+/// group's bindings (ascending, as [`group_layout`] lists them), each given its binding
+/// number from the linkage. Panics if the counts differ: a shader and its host out of step.
+pub fn group_entries<'a>(entries: &[&EntryPoint], group: u32, resources: Vec<wgpu::BindingResource<'a>>) -> Vec<wgpu::BindGroupEntry<'a>> {
+    let layout = group_layout(entries, group);
+    assert_eq!(layout.len(), resources.len(), "group {group}: the linkage has {} bindings, the host binds {}", layout.len(), resources.len());
+    layout.iter().zip(resources).map(|(l, resource)| wgpu::BindGroupEntry { binding: l.binding, resource }).collect()
+}
+
 /// The graphics APIs splitsum looks for adapters on: `WGPU_BACKEND` (wgpu's own variable,
 /// a comma-separated list such as `vulkan`, `gl`, `metal`, `dx12`) if set, else every API
 /// this build of wgpu has.
