@@ -176,7 +176,8 @@ pub fn read<K: Kernels>(k: &K, made: Made<K::Texels>, job: &Job) -> Result<Baked
 
 /// Bakes `products` of `env` with `settings` on `backend`, into host memory.
 pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products: Products) -> Result<Baked> {
-    bake_job(backend, env, &settings.resolve(InputShape::of(env), products)?)
+    let job = settings.resolve(InputShape::of(env), products)?;
+    bake_job(backend, env, &job)
 }
 
 /// Bakes `job` (resolved for `env`) on `backend`, into host memory.

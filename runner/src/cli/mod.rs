@@ -205,6 +205,20 @@ impl DisplayBakeArgs {
     pub fn settings(&self, env: &environment::Environment) -> Settings {
         Settings { size: self.size, samples: self.samples, ..Settings::display(env.native_face_size()) }
     }
+
+    /// The display's bake of `env` on `backend` (`render` and `view`): what it adjusts
+    /// stated, a bake estimated over an hour refused unless `force`; with its seconds.
+    pub fn bake(&self, env: &environment::Environment, backend: &Backend, force: bool) -> anyhow::Result<(crate::bake::BakedEnvironment, f64)> {
+        use crate::bake;
+        let job = self.settings(env).resolve(crate::settings::InputShape::of(env), crate::settings::Products::DISPLAY)?;
+        for a in job.adjustments() {
+            eprintln!("note: {}", a.describe(&flag_of));
+        }
+        bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), force)?;
+        let start = Instant::now();
+        let baked = bake::bake_job(backend, env, &job)?.into_display(job.mapping);
+        Ok((baked, start.elapsed().as_secs_f64()))
+    }
 }
 
 /// The quality knobs of a bake.

@@ -1,7 +1,6 @@
 //! `runner render`: one frame offscreen, on the GPU or the CPU reference renderer.
 
 use super::*;
-use crate::bake;
 
 #[derive(Args)]
 pub(super) struct RenderArgs {
@@ -55,14 +54,7 @@ pub(super) fn render(args: RenderArgs, given: &[String]) -> anyhow::Result<()> {
     let model = args.look.load_model()?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(args.backend)?;
-    let job = args.bake.settings(&env).resolve(crate::settings::InputShape::of(&env), Products::DISPLAY)?;
-    for a in job.adjustments() {
-        eprintln!("note: {}", a.describe(&flag_of));
-    }
-    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.scene.force)?;
-    let start = Instant::now();
-    let baked = bake::bake_job(&backend, &env, &job)?.into_display(job.mapping);
-    let bake_secs = start.elapsed().as_secs_f64();
+    let (baked, bake_secs) = args.bake.bake(&env, &backend, args.scene.force)?;
     let view = args.look.view(baked.auto_exposure());
     let start = Instant::now();
     let frame = view.frame(baked.shape(), args.width, args.height, true);

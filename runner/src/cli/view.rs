@@ -1,7 +1,6 @@
 //! `runner view`: the interactive viewer.
 
 use super::*;
-use crate::bake;
 
 #[derive(Args)]
 pub(super) struct ViewArgs {
@@ -53,14 +52,8 @@ pub(super) fn view(args: ViewArgs, given: &[String]) -> anyhow::Result<()> {
     let model = args.look.load_model()?;
     let (env, name) = load_environment(args.env.as_deref(), args.bake.sanitize)?;
     let backend = Backend::open(BackendKind::Gpu)?;
-    let job = args.bake.settings(&env).resolve(crate::settings::InputShape::of(&env), Products::DISPLAY)?;
-    for a in job.adjustments() {
-        eprintln!("note: {}", a.describe(&flag_of));
-    }
-    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.scene.force)?;
-    let start = Instant::now();
-    let baked = bake::bake_job(&backend, &env, &job)?.into_display(job.mapping);
-    println!("{name} baked on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
+    let (baked, seconds) = args.bake.bake(&env, &backend, args.scene.force)?;
+    println!("{name} baked on {} in {seconds:.2} s", backend.describe());
     let Backend::Gpu(gpu) = backend else { unreachable!("opened as GPU") };
     let state = args.look.view(baked.auto_exposure());
     let options = crate::view::ViewOptions {
