@@ -45,7 +45,7 @@ enum Command {
     /// Open the interactive viewer (needs a display; `runner render` does without).
     View(view::ViewArgs),
     /// Measure error against run time of every product on every backend (report.md,
-    /// report.csv, error_vs_time.png).
+    /// report.csv, report.html and its figures).
     Report(report::ReportArgs),
     /// Show what a scene needs baked and why, what is left out and why, and the cost.
     Plan(plan::PlanArgs),
