@@ -12,7 +12,7 @@ fn quick_report_writes_tables_csv_and_plot() {
     let html = std::fs::read_to_string(dir.join("report.html")).unwrap();
     let svg = std::fs::read_to_string(dir.join("error_vs_time.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("mean relative error") && svg.contains("bake time (ms)"));
-    for file in ["surface_splitsum.png", "surface_exact.png", "surface_error.png"] {
+    for file in ["surface0_splitsum.png", "surface0_exact.png", "surface0_error.png", "surface1_splitsum.png", "surface1_error.png"] {
         let png = image::open(dir.join(file)).expect("a PNG").to_rgb8();
         assert!(png.width() > 200 && png.height() > 50, "{file}");
         assert!(html.contains(file) && md.contains(file), "{file} is on the page");

@@ -15,4 +15,5 @@ pub mod accuracy;
 pub mod measurement;
 pub mod plot;
 pub mod report;
+pub mod skies;
 pub mod surface;

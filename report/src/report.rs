@@ -236,16 +236,20 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
         let _step = splitsum::progress::step(&format!("report: end to end on {}", backend.describe()), None);
         rows.extend(crate::accuracy::measure(backend, env, &methods, &points)?);
     }
-    // The error on surfaces: the defaults' sphere grid against the exact integral.
-    let map = {
-        let _step = splitsum::progress::step("report: error on surfaces (f64 sphere grid)", None);
-        let defaults = methods.iter().find(|m| m.kind == crate::measurement::Method::Defaults && m.settings.samples == Settings::default().samples);
-        let baked = bake::bake_for_display(&backends[0], env, &defaults.unwrap_or(&methods[0]).settings)?;
-        let exact = reference::Environment::new(acc_source.level(0), acc_source.layout.size);
-        crate::surface::error_map(&baked, &exact)
-    };
+    // The error on surfaces: the defaults' sphere grid against the exact integral, on this
+    // environment and on a clear sky with a sun 10⁴ times brighter than its zenith.
+    let defaults = &methods.iter().find(|m| m.kind == Method::Defaults && m.settings.samples == Settings::default().samples).unwrap_or(&methods[0]).settings;
+    let sky = crate::skies::sunny(4 * src.max(64), 1e4);
+    let mut maps = Vec::new();
+    for (what, e) in [(name.to_string(), env), ("a clear sky with a sun of 10^4 (generated)".to_string(), &sky)] {
+        let _step = splitsum::progress::step(&format!("report: error on surfaces of {what} (f64 sphere grid)"), None);
+        let baked = bake::bake_for_display(&backends[0], e, &Settings { size: src, source_size: Some(src), ..defaults.clone() })?;
+        let cube = bake::host_source_cube(&Backend::Cpu, e, &Settings { source_size: Some(src), size: src, ..Settings::default() })?;
+        let exact = reference::Environment::new(cube.level(0), cube.layout.size);
+        maps.push((what, crate::surface::error_map(&baked, &exact)));
+    }
     let _step = splitsum::progress::step("report: writing report.html, report.md, report.csv and the figures", None);
-    write_outputs(dir, name, backends, sweep, &rows, &map)?;
+    write_outputs(dir, name, backends, sweep, &rows, &maps)?;
     Ok(rows)
 }
 
@@ -601,14 +605,18 @@ fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
 
-fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement], map: &ErrorMap) -> Result<()> {
+fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement], maps: &[(String, ErrorMap)]) -> Result<()> {
     files::write_atomic(&dir.join("report.csv"), |w| splitsum::measured::write_csv(w, rows).map_err(std::io::Error::other))?;
     let svg = |w: &mut dyn std::io::Write, drawn: std::result::Result<String, Box<dyn std::error::Error>>| -> std::io::Result<()> {
         w.write_all(drawn.map_err(|e| std::io::Error::other(e.to_string()))?.as_bytes())
     };
     files::write_atomic(&dir.join("error_vs_time.svg"), |w| svg(w, crate::plot::small_multiples(&panels(rows), 3)))?;
-    for (file, rgb) in [("surface_splitsum.png", &map.splitsum), ("surface_exact.png", &map.exact), ("surface_error.png", &map.error)] {
-        files::write_png(&dir.join(file), map.width, map.height, rgb)?;
+    // surface{k}_splitsum.png, surface{k}_exact.png, surface{k}_error.png for each map.
+    let picture = |k: usize, kind: &str| format!("surface{k}_{kind}.png");
+    for (k, (_, map)) in maps.iter().enumerate() {
+        for (kind, rgb) in [("splitsum", &map.splitsum), ("exact", &map.exact), ("error", &map.error)] {
+            files::write_png(&dir.join(picture(k, kind)), map.width, map.height, rgb)?;
+        }
     }
     files::write_atomic(&dir.join("surface_scale.svg"), |w| {
         svg(w, crate::plot::colour_scale("relative luminance error", crate::surface::false_colour, &crate::surface::scale_ticks()))
@@ -620,20 +628,23 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         sweep.source_size, sweep.specular_size, sweep.mips
     );
     let references = "References (f64, independent of the code under test): adaptive Gauss-Kronrod quadrature for the BRDF table; exact sums over every texel of the source for the prefilter and the irradiance; the full reflectance integral (exact Smith, no split) for the shaded colour. Errors are relative: of the luminance, and for the table of the directional albedo F0*A + B (the larger of F0 = 0.04 and 1). Times are wall-clock, uploads and readbacks included.";
-    let surface = format!(
-        "Sphere grid (metal above, dielectric below; roughness {} across), orthographic view, shaded by splitsum from the default bake on {} against the exact integral: mean relative error {:.2}%, max {:.0}%.",
+    let grid = format!(
+        "Sphere grid (metal above, dielectric below; roughness {} across), orthographic view, shaded by splitsum from the default bake on {} against the exact integral (exact Smith, no split), with their relative luminance error.",
         crate::surface::ROUGHNESS.iter().map(|r| format!("{r}")).collect::<Vec<_>>().join(", "),
-        backends[0].describe(),
-        100.0 * map.mean,
-        100.0 * map.max
+        backends[0].describe()
     );
+    let caption = |what: &str, map: &ErrorMap| format!("{what}: mean relative error {:.2} %, max {:.0} %.", 100.0 * map.mean, 100.0 * map.max);
     let tables = tables(rows);
     let best = best_per_ms(rows);
 
     // Markdown.
     let mut md = String::new();
     let _ = writeln!(md, "# splitsum: error against run time\n\n{setup}\n\n{references}\n");
-    let _ = writeln!(md, "![error against run time](error_vs_time.svg)\n\n{surface}\n\n| splitsum | exact | error |\n|---|---|---|\n| ![](surface_splitsum.png) | ![](surface_exact.png) | ![](surface_error.png) |\n\n![scale](surface_scale.svg)");
+    let _ = writeln!(md, "![error against run time](error_vs_time.svg)\n\n{grid}\n\n| environment | splitsum | exact | error |\n|---|---|---|---|");
+    for (k, (what, map)) in maps.iter().enumerate() {
+        let _ = writeln!(md, "| {} | ![]({}) | ![]({}) | ![]({}) |", caption(what, map), picture(k, "splitsum"), picture(k, "exact"), picture(k, "error"));
+    }
+    let _ = writeln!(md, "\n![scale](surface_scale.svg)");
     for (title, header, cells) in &tables {
         let _ = writeln!(md, "\n## {title}\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
         for c in cells {
@@ -655,11 +666,18 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
     );
     let _ = writeln!(html, "<h1>splitsum: error against run time</h1>\n<p>{}</p>\n<p>{}</p>", html_escape(&setup), html_escape(references));
     let _ = writeln!(html, "<figure id=\"error-vs-time\"><img src=\"error_vs_time.svg\" alt=\"error against run time, one panel per product\"><figcaption>Mean relative error against bake time, one panel per product: one colour per method, the GPU solid and the CPU dashed; ringed points are each panel's Pareto front.</figcaption></figure>");
-    let _ = writeln!(
-        html,
-        "<figure id=\"surfaces\" class=\"maps\"><img src=\"surface_splitsum.png\" alt=\"splitsum\"><img src=\"surface_exact.png\" alt=\"exact\"><img src=\"surface_error.png\" alt=\"error\"><br><img src=\"surface_scale.svg\" alt=\"error scale\"><figcaption>Left to right: splitsum, the exact integral, their relative error. {}</figcaption></figure>",
-        html_escape(&surface)
-    );
+    let _ = writeln!(html, "<h2>The error on surfaces</h2>\n<p>{}</p>", html_escape(&grid));
+    for (k, (what, map)) in maps.iter().enumerate() {
+        let _ = writeln!(
+            html,
+            "<figure class=\"maps\"><img src=\"{}\" alt=\"splitsum\"><img src=\"{}\" alt=\"exact\"><img src=\"{}\" alt=\"error\"><figcaption>Left to right: splitsum, the exact integral, their relative error. {}</figcaption></figure>",
+            picture(k, "splitsum"),
+            picture(k, "exact"),
+            picture(k, "error"),
+            html_escape(&caption(what, map))
+        );
+    }
+    let _ = writeln!(html, "<img src=\"surface_scale.svg\" alt=\"error scale\">");
     for (title, header, cells) in &tables {
         let _ = writeln!(html, "<h2>{}</h2>\n<table><tr>{}</tr>", html_escape(title), header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>());
         for c in cells {
