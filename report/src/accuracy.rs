@@ -291,8 +291,12 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             knob: Knob::Samples,
             ..Measurement::of(product, method.kind, errors, Metric::RelativeLuminance)
         };
-        let all: Vec<f64> = per_point.iter().map(|p| p.parts[0].1).collect();
-        rows.push(Measurement { time_ms: Some(ms), ..row(Product::ShadedColour, &all) });
+        // Over every point: the total (with the bake's time) and each part.
+        for k in 0..4 {
+            let all: Vec<f64> = per_point.iter().map(|p| p.parts[k].1).collect();
+            let time_ms = (k == 0).then_some(ms);
+            rows.push(Measurement { part: per_point[0].parts[k].0, time_ms, ..row(Product::ShadedColour, &all) });
+        }
         // By roughness band, then by view band, each split into its parts.
         let mut roughness: Vec<(f32, f32)> = per_point.iter().map(|p| roughness_band(p.roughness)).collect();
         let mut views: Vec<(f32, f32)> = per_point.iter().map(|p| view_band(p.n_dot_v)).collect();

@@ -15,5 +15,6 @@ pub mod accuracy;
 pub mod measurement;
 pub mod plot;
 pub mod report;
+pub mod sets;
 pub mod skies;
 pub mod surface;

@@ -5,7 +5,7 @@
 use splitsum_reference as reference;
 use splitsum_shaders::glam::Vec3;
 
-pub use splitsum::measured::{Knob, Measurement, Method, Metric, Part, Product};
+pub use splitsum::measured::{Knob, Measurement, Method, Metric, Part, Product, Set};
 
 /// `[x, y, z]` in f64.
 pub fn arr(v: Vec3) -> [f64; 3] {

@@ -130,6 +130,19 @@ impl Sweep {
         methods
     }
 
+    /// The methods the measure over sets compares: the seed at its 1024 samples, the
+    /// defaults, and each shading option.
+    pub fn set_methods(&self, native: u32) -> Vec<crate::accuracy::Method> {
+        let n = Settings::default().samples;
+        self.methods(native)
+            .into_iter()
+            .filter(|m| match m.kind {
+                Method::Seed => m.settings.samples == 1024,
+                _ => m.settings.samples == n,
+            })
+            .collect()
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn with(
         source_size: u32,
@@ -194,9 +207,24 @@ fn directions(n: u32) -> Vec<Vec3> {
     (0..n).map(|i| splitsum_shaders::equirect::uv_to_dir(sampling::hammersley(i, n) * Vec2::new(1.0, 0.96) + Vec2::new(0.0, 0.02))).collect()
 }
 
-/// Runs the report's sweeps of `env` on `backends`, writes the three files into `dir`, and
-/// returns the measurements.
-pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, dir: &Path) -> Result<Vec<Measurement>> {
+/// The measure over the tuning and held-out sets ([`crate::sets`]), when a report asks.
+#[derive(Clone, Debug)]
+pub struct Sets {
+    /// The folder of Blender's studio lights.
+    pub dir: std::path::PathBuf,
+    /// Only the environments present (and the generated ones), for a quick report.
+    pub present_only: bool,
+}
+
+/// Runs the report's sweeps of `env` on `backends` (and the measure over `sets`, if
+/// given, on the first backend), writes the files into `dir`, and returns the
+/// measurements.
+pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, sets: Option<&Sets>, dir: &Path) -> Result<Vec<Measurement>> {
+    if let Some(s) = sets
+        && !s.present_only
+    {
+        crate::sets::check(&s.dir)?;
+    }
     files::create_folder(dir)?;
     files::check_writable(&dir.join("report.md"))?;
     let settings = Settings { source_size: Some(sweep.source_size), size: sweep.source_size, ..Settings::default() };
@@ -236,10 +264,17 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, d
         let _step = splitsum::progress::step(&format!("report: end to end on {}", backend.describe()), None);
         rows.extend(crate::accuracy::measure(backend, env, &methods, &points)?);
     }
+    if let Some(sets) = sets {
+        let keep = |m: &crate::sets::Member| match m.source {
+            crate::sets::Source::File(f) => !sets.present_only || sets.dir.join(f).exists(),
+            _ => true,
+        };
+        rows.extend(crate::sets::run(&backends[0], &sets.dir, sweep.accuracy_source, sweep.accuracy_points, |n| sweep.set_methods(n), keep)?);
+    }
     // The error on surfaces: the defaults' sphere grid against the exact integral, on this
     // environment and on a clear sky with a sun 10⁴ times brighter than its zenith.
     let defaults = &methods.iter().find(|m| m.kind == Method::Defaults && m.settings.samples == Settings::default().samples).unwrap_or(&methods[0]).settings;
-    let sky = crate::skies::sunny(4 * src.max(64), 1e4);
+    let sky = crate::skies::sunny(4 * src.max(64), 1e4, 35.0);
     let mut maps = Vec::new();
     for (what, e) in [(name.to_string(), env), ("a clear sky with a sun of 10^4 (generated)".to_string(), &sky)] {
         let _step = splitsum::progress::step(&format!("report: error on surfaces of {what} (f64 sphere grid)"), None);
@@ -493,7 +528,7 @@ fn shaded_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, 
 /// size sweep and every end-to-end method (the bias and cube-size sweeps, and the bands,
 /// are in the tables only).
 pub fn panel(r: &Measurement) -> Option<String> {
-    if r.time_ms.is_none() || r.part != Part::Total || r.backend.is_empty() {
+    if r.time_ms.is_none() || r.part != Part::Total || r.backend.is_empty() || r.set.is_some() {
         return None;
     }
     match (r.product, r.knob) {
@@ -573,7 +608,7 @@ type Table = (String, [&'static str; 8], Vec<[String; 8]>);
 
 /// The report's tables: one per product, rows in measurement order.
 fn tables(rows: &[Measurement]) -> Vec<Table> {
-    let mut products: Vec<Product> = rows.iter().map(|r| r.product).collect();
+    let mut products: Vec<Product> = rows.iter().filter(|r| r.set.is_none()).map(|r| r.product).collect();
     products.sort();
     products.dedup();
     let header = ["method", "backend", "setting", "band", "part", "time (ms)", "mean error", "max error"];
@@ -582,7 +617,7 @@ fn tables(rows: &[Measurement]) -> Vec<Table> {
         .map(|p| {
             let cells = rows
                 .iter()
-                .filter(|r| r.product == p)
+                .filter(|r| r.product == p && r.set.is_none())
                 .map(|r| {
                     [
                         r.method.title().to_string(),
@@ -599,6 +634,85 @@ fn tables(rows: &[Measurement]) -> Vec<Table> {
             (p.title().to_string(), header, cells)
         })
         .collect()
+}
+
+/// What the measure over sets is, in the report.
+const SETS_NOTE: &str = "The end-to-end measure (shaded colour against the full reflectance integral, exact Smith, no split) over environments of every kind. Design choices may look at the tuning set only; the held-out set confirms them. Mean relative luminance error over each set's environments (the largest point in brackets).";
+
+/// `mean (max)` over the environments of a set: the mean of their means, the largest of
+/// their maxima; `-` where no row matches.
+fn over_environments<'a>(rows: impl Iterator<Item = &'a Measurement>) -> String {
+    let (mut sum, mut n, mut max) = (0.0, 0usize, 0.0f64);
+    for r in rows {
+        sum += r.mean_error;
+        n += 1;
+        max = max.max(r.max_error);
+    }
+    if n == 0 { "-".into() } else { format!("{:.1} % ({:.0} %)", 100.0 * sum / n as f64, 100.0 * max) }
+}
+
+/// The measure over sets: per set, each method's shaded colour over every point and per
+/// `n·v` band, the bake's share and the prefiltered lookup (mean over the set's
+/// environments, max in brackets); then each environment's figures for the defaults.
+fn set_tables(rows: &[Measurement]) -> Vec<Table> {
+    use crate::measurement::Set;
+    let set_rows: Vec<&Measurement> = rows.iter().filter(|r| r.set.is_some()).collect();
+    if set_rows.is_empty() {
+        return vec![];
+    }
+    let no_band = |r: &Measurement| r.roughness_lo.is_none() && r.nv_lo.is_none() && r.near_sun.is_none();
+    let mut methods: Vec<(Method, u32)> = set_rows.iter().map(|r| (r.method, r.samples.unwrap_or(0))).collect();
+    methods.sort();
+    methods.dedup();
+    let mut tables = Vec::new();
+    for set in [Set::Tuning, Set::HeldOut] {
+        let mut envs: Vec<&str> = set_rows.iter().filter(|r| r.set == Some(set)).map(|r| r.environment.as_str()).collect();
+        envs.dedup();
+        let of = |m: (Method, u32)| set_rows.iter().copied().filter(move |r| r.set == Some(set) && (r.method, r.samples.unwrap_or(0)) == m);
+        let cells = methods
+            .iter()
+            .map(|&m| {
+                let shaded = |part: Part| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == part && no_band(r)));
+                let view = |hi: f32| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
+                [
+                    format!("{}, {} samples", m.0.title(), m.1),
+                    shaded(Part::Total),
+                    view(0.1),
+                    view(0.3),
+                    view(0.6),
+                    view(1.0),
+                    shaded(Part::Bake),
+                    over_environments(of(m).filter(|r| r.product == Product::PrefilteredLookup && no_band(r))),
+                ]
+            })
+            .collect();
+        let header = ["method", "shaded colour", "n·v ≤ 0.1", "0.1–0.3", "0.3–0.6", "0.6–1", "(a) bake's share", "prefiltered lookup"];
+        tables.push((format!("{}: {}", set.title(), envs.join(", ")), header, cells));
+    }
+    let defaults = (Method::Defaults, Settings::default().samples);
+    let mut envs: Vec<(&str, Set)> = set_rows.iter().map(|r| (r.environment.as_str(), r.set.expect("set rows"))).collect();
+    envs.dedup();
+    let cells = envs
+        .iter()
+        .map(|&(env, set)| {
+            let of = |m: (Method, u32)| set_rows.iter().copied().filter(move |r| r.environment == env && (r.method, r.samples.unwrap_or(0)) == m);
+            let shaded = |m, part: Part| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == part && no_band(r)));
+            let view = |hi: f32| over_environments(of(defaults).filter(|r| r.product == Product::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
+            [
+                env.to_string(),
+                set.title().to_string(),
+                shaded(defaults, Part::Total),
+                view(0.3),
+                view(0.1),
+                shaded(defaults, Part::Bake),
+                shaded(defaults, Part::SplitSum),
+                shaded((Method::Seed, 1024), Part::Total),
+            ]
+        })
+        .collect();
+    let header = ["environment", "set", "defaults", "n·v 0.1–0.3", "n·v ≤ 0.1", "(a) bake", "(b) split sum", "seed, 1024 samples"];
+    tables.push(("each environment (shaded colour, defaults unless named)".to_string(), header, cells));
+    tables
 }
 
 fn html_escape(s: &str) -> String {
@@ -635,6 +749,7 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
     );
     let caption = |what: &str, map: &ErrorMap| format!("{what}: mean relative error {:.2} %, max {:.0} %.", 100.0 * map.mean, 100.0 * map.max);
     let tables = tables(rows);
+    let set_tables = set_tables(rows);
     let best = best_per_ms(rows);
 
     // Markdown.
@@ -645,7 +760,10 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         let _ = writeln!(md, "| {} | ![]({}) | ![]({}) | ![]({}) |", caption(what, map), picture(k, "splitsum"), picture(k, "exact"), picture(k, "error"));
     }
     let _ = writeln!(md, "\n![scale](surface_scale.svg)");
-    for (title, header, cells) in &tables {
+    if !set_tables.is_empty() {
+        let _ = writeln!(md, "\n## Tuning and held-out sets\n\n{SETS_NOTE}");
+    }
+    for (title, header, cells) in set_tables.iter().chain(&tables) {
         let _ = writeln!(md, "\n## {title}\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
         for c in cells {
             let _ = writeln!(md, "| {} |", c.join(" | "));
@@ -678,7 +796,10 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         );
     }
     let _ = writeln!(html, "<img src=\"surface_scale.svg\" alt=\"error scale\">");
-    for (title, header, cells) in &tables {
+    if !set_tables.is_empty() {
+        let _ = writeln!(html, "<h2>Tuning and held-out sets</h2>\n<p>{}</p>", html_escape(SETS_NOTE));
+    }
+    for (title, header, cells) in set_tables.iter().chain(&tables) {
         let _ = writeln!(html, "<h2>{}</h2>\n<table><tr>{}</tr>", html_escape(title), header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>());
         for c in cells {
             let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());

@@ -7,9 +7,9 @@ use splitsum::texture::Equirect;
 use splitsum_shaders::equirect::uv_to_dir;
 use splitsum_shaders::glam::{Vec2, Vec3, Vec4};
 
-/// The sun's direction: 35° above the horizon.
-pub fn sun_direction() -> Vec3 {
-    let (elevation, azimuth) = (35f32.to_radians(), 40f32.to_radians());
+/// The sun's direction at `elevation` degrees above the horizon.
+pub fn sun_direction(elevation: f32) -> Vec3 {
+    let (elevation, azimuth) = (elevation.to_radians(), 40f32.to_radians());
     Vec3::new(elevation.cos() * azimuth.sin(), elevation.sin(), -elevation.cos() * azimuth.cos())
 }
 
@@ -17,11 +17,11 @@ pub fn sun_direction() -> Vec3 {
 /// equirect resolves its disc).
 pub const SUN_RADIUS_DEGREES: f32 = 0.5;
 
-/// A clear sky `width`×`width/2` with a sun of radiance `sun` (white), its disc
-/// supersampled 4×4 per texel so that its edge is area-weighted.
-pub fn sunny(width: u32, sun: f32) -> Environment {
+/// A clear sky `width`×`width/2` with a sun of radiance `sun` (white) at `elevation`
+/// degrees, its disc supersampled 4×4 per texel so that its edge is area-weighted.
+pub fn sunny(width: u32, sun: f32, elevation: f32) -> Environment {
     let height = width / 2;
-    let s = sun_direction();
+    let s = sun_direction(elevation);
     let cos_radius = SUN_RADIUS_DEGREES.to_radians().cos();
     let sky = |d: Vec3| -> Vec3 {
         if d.y < 0.0 {
@@ -52,5 +52,21 @@ pub fn sunny(width: u32, sun: f32) -> Environment {
             c.extend(1.0)
         })
         .collect::<Vec<Vec4>>();
+    Environment::Equirect(Equirect { width, height, texels })
+}
+
+/// An overcast sky `width`×`width/2`: the CIE standard overcast sky, radiance
+/// `(1 + 2 cos θ)/3` of its zenith's (Moon & Spencer 1942), over a ground of albedo 0.2 lit
+/// by it (`E = 7π/9` of the zenith radiance, reflected as `0.2·E/π`).
+pub fn overcast(width: u32) -> Environment {
+    let height = width / 2;
+    let zenith = Vec3::new(0.9, 0.92, 1.0);
+    let texels = (0..width * height)
+        .map(|i| {
+            let d = uv_to_dir(Vec2::new(((i % width) as f32 + 0.5) / width as f32, ((i / width) as f32 + 0.5) / height as f32));
+            let c = if d.y >= 0.0 { zenith * (1.0 + 2.0 * d.y) / 3.0 } else { zenith * (0.2 * 7.0 / 9.0) };
+            c.extend(1.0)
+        })
+        .collect();
     Environment::Equirect(Equirect { width, height, texels })
 }

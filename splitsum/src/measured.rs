@@ -109,6 +109,27 @@ pub enum Knob {
     None,
 }
 
+/// Which set of environments a row belongs to: choices are made on the tuning set and
+/// confirmed on the held-out set, which no choice looked at.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Set {
+    /// Environments the defaults may be chosen on.
+    Tuning,
+    /// Environments no choice looked at.
+    HeldOut,
+}
+
+impl Set {
+    /// Its name in the report.
+    pub fn title(self) -> &'static str {
+        match self {
+            Set::Tuning => "tuning set",
+            Set::HeldOut => "held-out set",
+        }
+    }
+}
+
 /// What the errors measure; both are relative.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -136,6 +157,10 @@ pub struct Measurement {
     pub backend: String,
     /// The backend's adapter and driver, or the CPU's threads.
     pub device: String,
+    /// The environment measured on (empty for the report's own).
+    pub environment: String,
+    /// The set the environment belongs to, for the measure over sets.
+    pub set: Option<Set>,
     /// Samples per texel (of specular mip 1, for a bake).
     pub samples: Option<u32>,
     /// The table's or the cube's face size.
@@ -178,6 +203,8 @@ impl Measurement {
             knob: Knob::None,
             backend: String::new(),
             device: String::new(),
+            environment: String::new(),
+            set: None,
             samples: None,
             size: None,
             source_size: None,

@@ -15,6 +15,14 @@ pub(super) struct ReportArgs {
     /// Backends to measure (those that cannot be opened are skipped, with a note).
     #[arg(long, value_parser = choice::<BackendKind>(), num_args = 1.., default_values = ["gpu", "cpu"])]
     backends: Vec<BackendKind>,
+    /// Also measure the shaded colour over the tuning set and the held-out set of
+    /// environments (a few minutes more; with --quick, only the environments present).
+    #[arg(long)]
+    sets: bool,
+    /// The folder of Blender's CC0 studio lights the sets read (`bash scripts/dev.sh
+    /// environments` fetches them there).
+    #[arg(long, default_value = "target/environments", requires = "sets")]
+    environments: PathBuf,
 }
 
 pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
@@ -30,7 +38,8 @@ pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
     let sweep = if args.quick { crate::report::Sweep::quick() } else { crate::report::Sweep::full() };
     let start = Instant::now();
     let out = files::OutputDir::begin(&args.out, "--out")?;
-    let rows = crate::report::run(&env, &name, &backends, &sweep, out.path())?;
+    let sets = args.sets.then(|| crate::report::Sets { dir: args.environments.clone(), present_only: args.quick });
+    let rows = crate::report::run(&env, &name, &backends, &sweep, sets.as_ref(), out.path())?;
     out.commit()?;
     println!("{} measurements in {:.1} s", rows.len(), start.elapsed().as_secs_f64());
     for (panel, r) in crate::report::best_per_ms(&rows) {
