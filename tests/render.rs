@@ -87,7 +87,16 @@ fn gpu_matches_the_cpu_reference() {
 fn shading_options_gpu_match_the_cpu_reference() {
     let base = ShadeOptions::IBL | ShadeOptions::DIRECT;
     let all = ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::MULTISCATTER | ShadeOptions::CORRELATED_SMITH | ShadeOptions::FILTERED_SAMPLING;
-    let extras = [0, ShadeOptions::DOMINANT_DIRECTION, ShadeOptions::MULTISCATTER, ShadeOptions::CORRELATED_SMITH, ShadeOptions::FILTERED_SAMPLING, all];
+    let extras = [
+        0,
+        ShadeOptions::DOMINANT_DIRECTION,
+        ShadeOptions::MULTISCATTER,
+        ShadeOptions::CORRELATED_SMITH,
+        ShadeOptions::FILTERED_SAMPLING,
+        ShadeOptions::LOG_MIP_BLEND,
+        all,
+        all & !ShadeOptions::FILTERED_SAMPLING | ShadeOptions::LOG_MIP_BLEND,
+    ];
     let worst_all =
         worst_gpu_vs_cpu(extras.map(|extra| ViewState { options: ShadeOptions { flags: base | extra, ..ShadeOptions::DEFAULT }, ..ViewState::default() }));
     println!("scene 96×64, shading options: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)");

@@ -106,6 +106,7 @@ impl ViewState {
                 (ShadeOptions::MULTISCATTER, "multiple scattering"),
                 (ShadeOptions::FILTERED_SAMPLING, "filtered"),
                 (ShadeOptions::CORRELATED_SMITH, "exact Smith for lights"),
+                (ShadeOptions::LOG_MIP_BLEND, "log mip blend"),
             ]
             .iter()
             .filter(|(bit, _)| flags & bit != 0)

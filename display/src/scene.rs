@@ -114,11 +114,15 @@ pub struct MaterialSpec {
     /// Smith–Schlick instead of the exact Smith term for direct lights.
     #[serde(default)]
     pub smith_schlick: bool,
+    /// Blend between mips linearly instead of in log luminance (see [`ShadingChoices`]).
+    #[serde(default)]
+    pub linear_mip_blend: bool,
 }
 
 /// The shading options a user chooses beside the models, with their defaults: the
-/// prefiltered cube read along the dominant direction, single scattering, no filtered
-/// sampling, the exact Smith term for direct lights. The one place their flags are made,
+/// prefiltered cube read along the dominant direction and blended between mips in log
+/// luminance, single scattering, no filtered sampling, the exact Smith term for direct
+/// lights. The one place their flags are made,
 /// and (with the `cli` feature) the command line's flags themselves; a scene file spells
 /// them as fields of its materials.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -139,6 +143,10 @@ pub struct ShadingChoices {
     /// `--lut-masking`).
     #[cfg_attr(feature = "cli", arg(long))]
     pub smith_schlick: bool,
+    /// Blend the two mips a roughness falls between linearly (the seed's choice) instead of
+    /// in log luminance.
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub linear_mip_blend: bool,
 }
 
 impl ShadingChoices {
@@ -156,6 +164,7 @@ impl ShadingChoices {
         set(self.multiscatter, ShadeOptions::MULTISCATTER);
         set(self.filtered, ShadeOptions::FILTERED_SAMPLING);
         set(!self.smith_schlick, ShadeOptions::CORRELATED_SMITH);
+        set(!self.linear_mip_blend, ShadeOptions::LOG_MIP_BLEND);
         f
     }
 }
@@ -185,6 +194,7 @@ impl MaterialSpec {
                 multiscatter: self.multiscatter,
                 filtered: self.filtered,
                 smith_schlick: self.smith_schlick,
+                linear_mip_blend: self.linear_mip_blend,
             }
             .flags(self.ibl, true),
         }

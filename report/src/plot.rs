@@ -38,6 +38,7 @@ pub fn method_colour(m: Method) -> RGBColor {
         Method::MultipleScattering => RGBColor(204, 121, 167),
         Method::FilteredSampling => RGBColor(86, 180, 233),
         Method::SmithSchlickTable => RGBColor(230, 159, 0),
+        Method::LinearMipBlend => RGBColor(0, 0, 0),
         Method::Sh9 => RGBColor(120, 94, 240),
         Method::ExactIngredients => RGBColor(90, 90, 90),
     }

@@ -125,6 +125,7 @@ impl Sweep {
             Method { kind: Kind::MirrorDirection, settings: default.clone(), flags: flags & !ShadeOptions::DOMINANT_DIRECTION },
             Method { kind: Kind::MultipleScattering, settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
             Method { kind: Kind::FilteredSampling, settings: default.clone(), flags: flags | ShadeOptions::FILTERED_SAMPLING },
+            Method { kind: Kind::LinearMipBlend, settings: default.clone(), flags: flags & !ShadeOptions::LOG_MIP_BLEND },
             Method { kind: Kind::SmithSchlickTable, settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default }, flags },
         ]);
         methods

@@ -24,6 +24,7 @@
 //! texels.
 
 use crate::math::{self, CompensatedSum, CompensatedSum4, MeanPartial};
+use crate::tonemap;
 use spirv_std::glam::{Vec2, Vec3, Vec4};
 
 /// Number of faces of a cube map.
@@ -258,6 +259,35 @@ pub fn sample_lod(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) -> Vec
     if t > 0.0 && m0 + 1 < layout.levels {
         let b = sample_bilinear(texels, layout, m0 + 1, d);
         math::finite4(a * (1.0 - t) + b * t)
+    } else {
+        a
+    }
+}
+
+/// [`sample_lod`] with the two levels blended in log luminance: the linear blend's
+/// colour, scaled so that its luminance is `L₀^(1−t)·L₁^t`, the geometric blend of the two
+/// levels' luminances. Near a bright source, prefiltered radiance changes by a factor from
+/// one roughness level to the next rather than by an amount, so a linear blend between
+/// mips overshoots towards the brighter level; the geometric one follows the factor.
+/// (Luminances below `1e-12` are taken as `1e-12`; a constant environment is returned as it
+/// is.)
+#[inline]
+pub fn sample_lod_log(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) -> Vec4 {
+    let max_lod = (layout.levels - 1) as f32;
+    let l = math::clamp(lod, 0.0, max_lod);
+    let l0 = math::floor(l);
+    let t = l - l0;
+    let m0 = l0 as u32;
+    let a = sample_bilinear(texels, layout, m0, d);
+    if t > 0.0 && m0 + 1 < layout.levels {
+        let b = sample_bilinear(texels, layout, m0 + 1, d);
+        let linear = a * (1.0 - t) + b * t;
+        let tiny = 1e-12;
+        let la = math::max(tonemap::luminance(a.truncate()), tiny);
+        let lb = math::max(tonemap::luminance(b.truncate()), tiny);
+        let geometric = math::exp2(math::log2(la) * (1.0 - t) + math::log2(lb) * t);
+        let scale = geometric / math::max(tonemap::luminance(linear.truncate()), tiny);
+        math::finite4((linear.truncate() * scale).extend(linear.w))
     } else {
         a
     }

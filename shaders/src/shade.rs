@@ -114,15 +114,20 @@ impl ShadeOptions {
     /// ([`FIS_SAMPLES`] GGX samples, filtered importance sampling) instead of blending the
     /// mirror with mip 1.
     pub const FILTERED_SAMPLING: u32 = 32;
+    /// Blend the two mips a roughness falls between in log luminance
+    /// ([`cubemap::sample_lod_log`]) instead of linearly.
+    pub const LOG_MIP_BLEND: u32 = 64;
 
     /// Cook–Torrance, Lambert, Schlick, both lights, the prefiltered cube read along the
-    /// dominant direction and the exact Smith term for direct lights (each measured closer
-    /// to the full reflectance integral by `runner report`).
+    /// dominant direction and blended between mips in log luminance, and the exact Smith
+    /// term for direct lights (each measured closer to the full reflectance integral by
+    /// `runner report`; the log blend chosen on the tuning set and confirmed on the
+    /// held-out set, `runner report --sets`).
     pub const DEFAULT: ShadeOptions = ShadeOptions {
         diffuse: DiffuseModel::Lambert as u32,
         specular: SpecularModel::CookTorrance as u32,
         fresnel: FresnelForm::Schlick as u32,
-        flags: Self::IBL | Self::DIRECT | Self::DOMINANT_DIRECTION | Self::CORRELATED_SMITH,
+        flags: Self::IBL | Self::DIRECT | Self::DOMINANT_DIRECTION | Self::CORRELATED_SMITH | Self::LOG_MIP_BLEND,
     };
 }
 
@@ -289,14 +294,17 @@ pub fn filtered_lookup(specular: &[Vec4], layout: CubeLayout, dir: Vec3, roughne
 }
 
 /// The prefiltered radiance along `dir` at `roughness`, as the display reads it: the
-/// trilinear lookup at the mip the roughness maps to, or with
-/// [`ShadeOptions::FILTERED_SAMPLING`] below mip 1 the [`filtered_lookup`].
+/// trilinear lookup at the mip the roughness maps to (in log luminance between mips with
+/// [`ShadeOptions::LOG_MIP_BLEND`]), or with [`ShadeOptions::FILTERED_SAMPLING`] below
+/// mip 1 the [`filtered_lookup`].
 #[inline]
 pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: Vec3, roughness: f32) -> Vec4 {
     let layout = CubeLayout::new(shape.specular_size, shape.specular_levels);
     let lod = RoughnessMapping::from_u32(shape.mapping).lod(roughness, shape.specular_levels);
     if flags & ShadeOptions::FILTERED_SAMPLING != 0 && lod > 0.0 && lod < 1.0 && shape.specular_levels > 1 {
         filtered_lookup(specular, layout, dir, roughness)
+    } else if flags & ShadeOptions::LOG_MIP_BLEND != 0 {
+        cubemap::sample_lod_log(specular, layout, dir, lod)
     } else {
         cubemap::sample_lod(specular, layout, dir, lod)
     }

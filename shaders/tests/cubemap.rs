@@ -204,3 +204,34 @@ fn mirrored_x_texel_mirrors_the_texel_centre() {
         }
     }
 }
+
+/// The log-luminance blend between two mips against its closed form: with level 0 a
+/// constant grey `a` and level 1 a constant grey `b`, the lookup at `lod = t` is
+/// `a^(1−t)·b^t` (the linear blend is `(1−t)·a + t·b`); a constant cube comes back as it is;
+/// a black level gives black, not NaN.
+#[test]
+fn log_luminance_mip_blend_is_geometric_between_levels() {
+    let layout = CubeLayout::new(4, 2);
+    let (a, b) = (8.0f32, 0.5f32);
+    let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
+    for (i, t) in texels.iter_mut().enumerate() {
+        let level0 = (i as u32) < layout.level_offset(1);
+        *t = Vec4::new(1.0, 1.0, 1.0, 1.0) * if level0 { a } else { b };
+        t.w = 1.0;
+    }
+    let d = Vec3::new(0.3, -0.5, 0.8).normalize();
+    for t in [0.0f32, 0.25, 0.5, 0.9, 1.0] {
+        let got = cubemap::sample_lod_log(&texels, layout, d, t);
+        let want = a.powf(1.0 - t) * b.powf(t);
+        assert!((got.x / want - 1.0).abs() < 2e-6 && (got.y - got.x).abs() < 1e-5 && got.w == 1.0, "t = {t}: {got} against {want}");
+    }
+    let constant = vec![Vec4::new(0.2, 0.4, 0.8, 1.0); layout.texel_count() as usize];
+    let got = cubemap::sample_lod_log(&constant, layout, d, 0.6);
+    assert!((got - Vec4::new(0.2, 0.4, 0.8, 1.0)).abs().max_element() < 1e-6, "{got}");
+    let mut black = texels.clone();
+    for t in black.iter_mut().skip(layout.level_offset(1) as usize) {
+        *t = Vec4::new(0.0, 0.0, 0.0, 1.0);
+    }
+    let got = cubemap::sample_lod_log(&black, layout, d, 0.5);
+    assert!(got.is_finite() && got.truncate().max_element() < 1e-3, "{got}");
+}

@@ -54,6 +54,8 @@ pub enum Method {
     FilteredSampling,
     /// The defaults with a Smith–Schlick table.
     SmithSchlickTable,
+    /// The defaults, blending between mips linearly (before the log-luminance blend).
+    LinearMipBlend,
     /// SH9 in place of the irradiance convolution.
     Sh9,
     /// The split sum from exact ingredients: the error of the approximation itself.
@@ -70,6 +72,7 @@ impl Method {
             Method::MultipleScattering => "defaults + multiple scattering",
             Method::FilteredSampling => "defaults + filtered sampling",
             Method::SmithSchlickTable => "defaults, Smith-Schlick table",
+            Method::LinearMipBlend => "defaults, linear mip blend",
             Method::Sh9 => "SH9",
             Method::ExactIngredients => "exact ingredients (split sum alone)",
         }
