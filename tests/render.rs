@@ -107,8 +107,9 @@ fn shading_options_gpu_match_the_cpu_reference() {
 /// The frame's projection (glam's right-handed, depth in [0, 1]) against its closed form:
 /// a point on the view axis at the near plane has depth 0, at the far plane 1; a point on
 /// the top edge of the field of view maps to y = +1 (wgpu's NDC is y-up), one on the right
-/// edge to x = +1; and the eye's ray through a pixel centre (`Frame::forward`, `right`,
-/// `up`, `tan_half_fov`, as the ray-cast scene builds it) projects back onto that pixel.
+/// edge to x = +1: the edges of the field of view the ray-cast scene builds from
+/// `Frame::forward`, `right`, `up` and `tan_half_fov`. Tolerance 1e-4: f32 rounding of a
+/// matrix product over distances up to 500 (the far plane).
 #[test]
 fn the_projection_is_right_handed_with_depth_zero_to_one() {
     use splitsum_shaders::glam::Vec3;

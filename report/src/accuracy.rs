@@ -252,7 +252,7 @@ struct PointErrors {
 
 /// Bakes each method on `backend`, times it and measures it at `points`.
 pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points: &Points) -> Result<Vec<Measurement>> {
-    let (engine, device) = (if backend.is_gpu() { "gpu" } else { "cpu" }, backend.describe());
+    let device = crate::measurement::Device::of(backend);
     let mut rows = Vec::new();
     for method in methods {
         let start = Instant::now();
@@ -285,11 +285,9 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             })
             .collect();
         let row = |product: Product, errors: &[f64]| Measurement {
-            backend: engine.into(),
-            device: device.clone(),
             samples: Some(method.settings.samples),
             knob: Knob::Samples,
-            ..Measurement::of(product, method.kind, errors, Metric::RelativeLuminance)
+            ..device.row(product, method.kind, errors, Metric::RelativeLuminance)
         };
         // Over every point: the total (with the bake's time) and each part.
         for k in 0..4 {

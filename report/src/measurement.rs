@@ -7,6 +7,25 @@ use splitsum_shaders::glam::Vec3;
 
 pub use splitsum::measured::{Knob, Measurement, Method, Metric, Part, Product, Set};
 
+/// The backend rows are measured on: its kind's name (`gpu`, `cpu`) and its description.
+pub struct Device {
+    engine: &'static str,
+    description: String,
+}
+
+impl Device {
+    /// The device of `backend`.
+    pub fn of(backend: &splitsum::backend::Backend) -> Self {
+        use splitsum_shaders::choice::Choice;
+        Self { engine: backend.kind().name(), description: backend.describe() }
+    }
+
+    /// A row of `product` by `method` on this device.
+    pub fn row(&self, product: Product, method: Method, errors: &[f64], metric: Metric) -> Measurement {
+        Measurement { backend: self.engine.into(), device: self.description.clone(), ..Measurement::of(product, method, errors, metric) }
+    }
+}
+
 /// `[x, y, z]` in f64.
 pub fn arr(v: Vec3) -> [f64; 3] {
     [v.x as f64, v.y as f64, v.z as f64]

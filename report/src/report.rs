@@ -15,7 +15,7 @@
 //! repository), `report.csv` (the typed rows, `splitsum::measured`), `error_vs_time.svg`
 //! (small multiples, [`crate::plot`]) and the error on surfaces ([`crate::surface`]).
 
-use crate::measurement::{Knob, Measurement, Method, Metric, Part, Product, arr, rel};
+use crate::measurement::{Device, Knob, Measurement, Method, Metric, Part, Product, arr, rel};
 use crate::surface::ErrorMap;
 use rayon::prelude::*;
 use splitsum::backend::Backend;
@@ -238,8 +238,8 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, s
     let mut rows = Vec::new();
     rows.extend(refs.split_error_rows());
     for backend in backends {
-        let b = Device { engine: if backend.is_gpu() { "gpu" } else { "cpu" }, description: backend.describe() };
-        let _step = splitsum::progress::step(&format!("report: every product on {}", b.description), None);
+        let b = Device::of(backend);
+        let _step = splitsum::progress::step(&format!("report: every product on {}", backend.describe()), None);
         // Warm-up, outside the timings: first dispatches pay for driver set-up and caches.
         backend.brdf_lut(4, 4)?;
         backend.brdf_table(4, Masking::SmithSchlick)?;
@@ -277,10 +277,12 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, s
     let defaults = &methods.iter().find(|m| m.kind == Method::Defaults && m.settings.samples == Settings::default().samples).unwrap_or(&methods[0]).settings;
     let sky = crate::skies::sunny(4 * src.max(64), 1e4, 35.0);
     let mut maps = Vec::new();
-    for (what, e) in [(name.to_string(), env), ("a clear sky with a sun of 10^4 (generated)".to_string(), &sky)] {
+    // The truth sums the source cube the end-to-end measure used (`acc_source`), or the
+    // sky's at the same size.
+    let sky_source = bake::host_source_cube(&Backend::Cpu, &sky, &Settings { source_size: Some(src), size: src, ..Settings::default() })?;
+    for (what, e, cube) in [(name.to_string(), env, &acc_source), ("a clear sky with a sun of 10^4 (generated)".to_string(), &sky, &sky_source)] {
         let _step = splitsum::progress::step(&format!("report: error on surfaces of {what} (f64 sphere grid)"), None);
         let baked = bake::bake_for_display(&backends[0], e, &Settings { size: src, source_size: Some(src), ..defaults.clone() })?;
-        let cube = bake::host_source_cube(&Backend::Cpu, e, &Settings { source_size: Some(src), size: src, ..Settings::default() })?;
         let exact = reference::Environment::new(cube.level(0), cube.layout.size);
         maps.push((what, crate::surface::error_map(&baked, &exact)));
     }
@@ -308,19 +310,6 @@ const VIEWS: [(f32, f32); 2] = [(0.59, 1.0), (0.0, 0.3)];
 fn in_view(p: &ShadingPoint, (lo, hi): (f32, f32)) -> bool {
     let nv = p.n.dot(p.v);
     nv > lo && nv <= hi + 1e-3
-}
-
-/// The backend a row was measured on: `gpu` or `cpu`, and its description.
-struct Device {
-    engine: &'static str,
-    description: String,
-}
-
-impl Device {
-    /// A row of `product` by `method` on this device.
-    fn row(&self, product: Product, method: Method, errors: &[f64], metric: Metric) -> Measurement {
-        Measurement { backend: self.engine.into(), device: self.description.clone(), ..Measurement::of(product, method, errors, metric) }
-    }
 }
 
 struct ShadingPoint {

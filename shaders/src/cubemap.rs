@@ -250,18 +250,7 @@ pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3)
 
 /// Seamless trilinear lookup at fractional level `lod`, clamped to the stored levels.
 pub fn sample_lod(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) -> Vec4 {
-    let max_lod = (layout.levels - 1) as f32;
-    let l = math::clamp(lod, 0.0, max_lod);
-    let l0 = math::floor(l);
-    let t = l - l0;
-    let m0 = l0 as u32;
-    let a = sample_bilinear(texels, layout, m0, d);
-    if t > 0.0 && m0 + 1 < layout.levels {
-        let b = sample_bilinear(texels, layout, m0 + 1, d);
-        math::finite4(a * (1.0 - t) + b * t)
-    } else {
-        a
-    }
+    sample_levels(texels, layout, d, lod, false)
 }
 
 /// [`sample_lod`] with the two levels blended in log luminance: the linear blend's
@@ -273,6 +262,13 @@ pub fn sample_lod(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) -> Vec
 /// is.)
 #[inline]
 pub fn sample_lod_log(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) -> Vec4 {
+    sample_levels(texels, layout, d, lod, true)
+}
+
+/// The bilinear samples of the two levels around `lod` (clamped to the stored levels),
+/// blended linearly, or in log luminance where `log`.
+#[inline]
+fn sample_levels(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32, log: bool) -> Vec4 {
     let max_lod = (layout.levels - 1) as f32;
     let l = math::clamp(lod, 0.0, max_lod);
     let l0 = math::floor(l);
@@ -282,12 +278,16 @@ pub fn sample_lod_log(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) ->
     if t > 0.0 && m0 + 1 < layout.levels {
         let b = sample_bilinear(texels, layout, m0 + 1, d);
         let linear = a * (1.0 - t) + b * t;
-        let tiny = 1e-12;
-        let la = math::max(tonemap::luminance(a.truncate()), tiny);
-        let lb = math::max(tonemap::luminance(b.truncate()), tiny);
-        let geometric = math::exp2(math::log2(la) * (1.0 - t) + math::log2(lb) * t);
-        let scale = geometric / math::max(tonemap::luminance(linear.truncate()), tiny);
-        math::finite4((linear.truncate() * scale).extend(linear.w))
+        if log {
+            let tiny = 1e-12;
+            let la = math::max(tonemap::luminance(a.truncate()), tiny);
+            let lb = math::max(tonemap::luminance(b.truncate()), tiny);
+            let geometric = math::exp2(math::log2(la) * (1.0 - t) + math::log2(lb) * t);
+            let scale = geometric / math::max(tonemap::luminance(linear.truncate()), tiny);
+            math::finite4((linear.truncate() * scale).extend(linear.w))
+        } else {
+            math::finite4(linear)
+        }
     } else {
         a
     }

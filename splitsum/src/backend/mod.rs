@@ -85,4 +85,9 @@ impl Backend {
     pub fn is_gpu(&self) -> bool {
         matches!(self, Backend::Gpu(_))
     }
+
+    /// Which backend this is.
+    pub fn kind(&self) -> BackendKind {
+        if self.is_gpu() { BackendKind::Gpu } else { BackendKind::Cpu }
+    }
 }
