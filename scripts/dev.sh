@@ -154,12 +154,27 @@ case "$cmd" in
         ensure_stable
         exec cargo +stable "$@"
         ;;
+    package)
+        # Every library crate packaged, and each package built on its own. cargo verifies
+        # a crate that depends on a sibling through a temporary local registry, and
+        # extracts each sibling into $CARGO_HOME/registry/src/<hash of that registry's
+        # path>/NAME-VERSION; when that folder already exists (an earlier package run from
+        # the same checkout path, at the same version) cargo reuses it, so the
+        # verification builds against the old source. Those folders are cargo's own
+        # extractions of this workspace's crates, never a user's: remove them first.
+        ensure_stable
+        version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)
+        for name in splitsum splitsum-shaders splitsum-spirv splitsum-reference splitsum-display splitsum-report; do
+            rm -rf "${CARGO_HOME:-$HOME/.cargo}"/registry/src/*/"$name-$version"
+        done
+        exec cargo +stable package --workspace --exclude splitsum-tests --exclude runner "$@"
+        ;;
     spirv)
         ensure_nightly
         exec cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
         ;;
     *)
-        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | spirv [--check] | peers | environments" >&2
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | peers | environments" >&2
         exit 2
         ;;
 esac
