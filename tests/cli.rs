@@ -32,6 +32,19 @@ fn lut_rejects_bad_sizes_and_counts() {
     assert!(!out.exists());
 }
 
+/// The shading ladder's rungs are 1, 2, 4, 8 and 16 fetches; anything else is refused by
+/// the flag's name before anything is baked.
+#[test]
+fn render_refuses_a_fetch_count_off_the_ladder() {
+    let d = scratch("fetches");
+    let out = d.join("frame.png");
+    for bad in ["3", "0", "32", "many"] {
+        let e = err(&["render", "--backend", "cpu", "--fetches", bad, "--out", out.to_str().unwrap()]);
+        assert!(e.contains("--fetches") && e.contains(bad), "{e}");
+    }
+    assert!(!out.exists());
+}
+
 #[test]
 fn lut_names_an_unwritable_path() {
     let d = scratch("dir");

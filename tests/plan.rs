@@ -404,6 +404,8 @@ fn scene_errors_name_the_file_and_the_problem() {
     assert!(load_error("[[materials]]\nname = \"a\"\nmetallic = \"wood\"\n").contains("metallic"));
     assert!(load_error("[[materials]]\nname = \"a\"\nspecular = \"ward\"\n").contains("ward"));
     assert!(load_error("[quality]\nmax_error = -1.0\n").contains("max_error"));
+    let e = load_error("[[materials]]\nname = \"a\"\nfetches = 3\n");
+    assert!(e.contains("fetches") && e.contains("1, 2, 4, 8 or 16"), "{e}");
     assert!(load_error("[[objects]]\nkind = \"teapot\"\n").contains("teapot"));
     let missing = std::env::temp_dir().join("splitsum-no-such-scene.toml");
     assert!(Scene::load(&missing).unwrap_err().to_string().contains("splitsum-no-such-scene.toml"));

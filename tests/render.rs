@@ -81,8 +81,9 @@ fn gpu_matches_the_cpu_reference() {
 }
 
 /// Every shading option of the image-based and direct light (dominant direction, multiple
-/// scattering, exact Smith for direct light, filtered sampling below mip 1), alone and all
-/// together, GPU against CPU, under the same bound as the models.
+/// scattering, exact Smith for direct light, filtered sampling below mip 1, the table read
+/// as `F₀·A + B`, the shading ladder's 2 to 16 fetches), alone and all together, GPU
+/// against CPU, under the same bound as the models.
 #[test]
 fn shading_options_gpu_match_the_cpu_reference() {
     let base = ShadeOptions::IBL | ShadeOptions::DIRECT;
@@ -96,9 +97,16 @@ fn shading_options_gpu_match_the_cpu_reference() {
         ShadeOptions::LOG_MIP_BLEND,
         all,
         all & !ShadeOptions::FILTERED_SAMPLING | ShadeOptions::LOG_MIP_BLEND,
+        ShadeOptions::TABLE_F0,
     ];
-    let worst_all =
-        worst_gpu_vs_cpu(extras.map(|extra| ViewState { options: ShadeOptions { flags: base | extra, ..ShadeOptions::DEFAULT }, ..ViewState::default() }));
+    let mut views: Vec<ViewState> =
+        extras.iter().map(|&extra| ViewState { options: ShadeOptions { flags: base | extra, ..ShadeOptions::DEFAULT }, ..ViewState::default() }).collect();
+    // The shading ladder's rungs: 2 to 16 fetches, seen from a low camera so that the
+    // grid's spheres show grazing views (where the ladder is used).
+    for fetches in [2, 4, 8, 16] {
+        views.push(ViewState { options: ShadeOptions::DEFAULT.with_fetches(fetches), pitch: 0.3, ..ViewState::default() });
+    }
+    let worst_all = worst_gpu_vs_cpu(views);
     println!("scene 96×64, shading options: GPU vs CPU max |Δ| = {worst_all:.2e} (display values)");
     let bound = frame_bound();
     assert!(worst_all < bound, "{worst_all:e} (bound {bound:e})");

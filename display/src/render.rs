@@ -101,7 +101,7 @@ impl ViewState {
     pub fn summary(&self) -> String {
         /// The image-based light's options, as ` (a, b)`, or nothing.
         fn ibl_options(flags: u32) -> String {
-            let names: Vec<&str> = [
+            let names: Vec<String> = [
                 (ShadeOptions::DOMINANT_DIRECTION, "dominant direction"),
                 (ShadeOptions::MULTISCATTER, "multiple scattering"),
                 (ShadeOptions::FILTERED_SAMPLING, "filtered"),
@@ -110,7 +110,8 @@ impl ViewState {
             ]
             .iter()
             .filter(|(bit, _)| flags & bit != 0)
-            .map(|&(_, name)| name)
+            .map(|&(_, name)| name.to_string())
+            .chain((ShadeOptions::fetches_of(flags) > 1).then(|| format!("{} fetches", ShadeOptions::fetches_of(flags))))
             .collect();
             if names.is_empty() { String::new() } else { format!(" ({})", names.join(", ")) }
         }
@@ -195,6 +196,52 @@ pub fn render(backend: &splitsum::Backend, env: &BakedEnvironment, frame: &Frame
         (splitsum::Backend::Cpu, Some(m)) => crate::raster::render(env, frame, m),
         (splitsum::Backend::Cpu, None) => render_cpu(env, frame),
     })
+}
+
+/// What shading one pixel of a sphere costs with `options` on `backend`, in nanoseconds: a
+/// `size`² frame of the default view's sphere grid, less the same frame without the
+/// spheres (the sky, the pass and the read-back), over the pixels the spheres cover (found
+/// by casting the frame's rays, `scene::hit_grid`). Each frame is the best of `repeats`;
+/// on the GPU one untimed frame first pays for pipelines and uploads. The spheres show
+/// every `n·v` in proportion to its projected area, so this is the mean over a sphere.
+pub fn shading_ns_per_pixel(backend: &splitsum::Backend, env: &BakedEnvironment, options: ShadeOptions, size: u32, repeats: u32) -> Result<f64> {
+    let view = ViewState { options, ..ViewState::default() };
+    let frame = view.frame(env.shape(), size, size, false);
+    let sky = ViewState { spheres: false, ..view }.frame(env.shape(), size, size, false);
+    let covered = (0..size * size)
+        .into_par_iter()
+        .filter(|i| {
+            let px = Vec2::new((i % size) as f32 + 0.5, (i / size) as f32 + 0.5);
+            scene::hit_grid(&frame, frame.eye.truncate(), scene::camera_ray(&frame, px)).0 > 0.0
+        })
+        .count()
+        .max(1);
+    let best = |f: &dyn Fn() -> Result<()>| -> Result<f64> {
+        let mut best = f64::INFINITY;
+        for _ in 0..repeats.max(1) {
+            let start = std::time::Instant::now();
+            f()?;
+            best = best.min(start.elapsed().as_secs_f64());
+        }
+        Ok(best)
+    };
+    let (with, without) = match backend {
+        splitsum::Backend::Gpu(g) => {
+            let scene = GpuScene::new(g, env);
+            scene.render_offscreen(g, &frame, None)?;
+            (best(&|| scene.render_offscreen(g, &frame, None).map(drop))?, best(&|| scene.render_offscreen(g, &sky, None).map(drop))?)
+        }
+        splitsum::Backend::Cpu => {
+            let time = |f: &Frame| {
+                best(&|| {
+                    std::hint::black_box(render_cpu(env, f));
+                    Ok(())
+                })
+            };
+            (time(&frame)?, time(&sky)?)
+        }
+    };
+    Ok((with - without).max(0.0) * 1e9 / covered as f64)
 }
 
 /// The CPU reference renderer: `scene::pixel` at every pixel centre, row 0 at the top.

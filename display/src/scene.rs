@@ -117,6 +117,10 @@ pub struct MaterialSpec {
     /// Blend between mips linearly instead of in log luminance (see [`ShadingChoices`]).
     #[serde(default)]
     pub linear_mip_blend: bool,
+    /// Prefiltered fetches per pixel of the shading ladder: 1, 2, 4, 8 or 16 (see
+    /// [`ShadingChoices`]).
+    #[serde(default = "one")]
+    pub fetches: u32,
 }
 
 /// The shading options a user chooses beside the models, with their defaults: the
@@ -147,6 +151,25 @@ pub struct ShadingChoices {
     /// in log luminance.
     #[cfg_attr(feature = "cli", arg(long))]
     pub linear_mip_blend: bool,
+    /// Prefiltered fetches per pixel: 1 is the split sum; 2, 4, 8 or 16 follow the true
+    /// specular lobe at grazing views (the shading ladder, `shade::lobe_radiance`), at that
+    /// many fetches' cost. `runner report` measures each rung's error against its cost.
+    #[cfg_attr(feature = "cli", arg(long, default_value_t = 1, value_parser = fetch_count))]
+    pub fetches: u32,
+}
+
+/// The rungs of the shading ladder a user may ask for.
+pub const FETCH_COUNTS: [u32; 5] = [1, 2, 4, 8, 16];
+
+/// `fetches` if it is a rung of the ladder, else what is wrong with it (for `--fetches`
+/// and the scene field `fetches`).
+pub fn check_fetches(fetches: u32) -> std::result::Result<u32, String> {
+    if FETCH_COUNTS.contains(&fetches) { Ok(fetches) } else { Err(format!("must be one of 1, 2, 4, 8 or 16 (the shading ladder's rungs), not {fetches}")) }
+}
+
+#[cfg(feature = "cli")]
+fn fetch_count(s: &str) -> std::result::Result<u32, String> {
+    check_fetches(s.parse::<u32>().map_err(|e| format!("{s:?}: {e}"))?)
 }
 
 impl ShadingChoices {
@@ -165,7 +188,7 @@ impl ShadingChoices {
         set(self.filtered, ShadeOptions::FILTERED_SAMPLING);
         set(!self.smith_schlick, ShadeOptions::CORRELATED_SMITH);
         set(!self.linear_mip_blend, ShadeOptions::LOG_MIP_BLEND);
-        f
+        ShadeOptions { flags: f, ..ShadeOptions::DEFAULT }.with_fetches(self.fetches).flags
     }
 }
 
@@ -181,6 +204,9 @@ fn half() -> Param {
 fn yes() -> bool {
     true
 }
+fn one() -> u32 {
+    1
+}
 
 impl MaterialSpec {
     /// The shader options of this material (direct lights on).
@@ -195,6 +221,7 @@ impl MaterialSpec {
                 filtered: self.filtered,
                 smith_schlick: self.smith_schlick,
                 linear_mip_blend: self.linear_mip_blend,
+                fetches: self.fetches,
             }
             .flags(self.ibl, true),
         }
@@ -396,6 +423,9 @@ impl Scene {
     fn check(&self) -> Result<()> {
         let bad = |m: String| Err(Error::Invalid(m));
         for m in &self.materials {
+            if let Err(problem) = check_fetches(m.fetches) {
+                return bad(format!("material {:?}: fetches {problem}", m.name));
+            }
             for (what, p) in [("metallic", &m.metallic), ("roughness", &m.roughness)] {
                 if let Param::Texture(t) = p
                     && t != "texture" {

@@ -8,7 +8,7 @@ use splitsum::backend::gpu::Gpu;
 use splitsum::bake::BakedEnvironment;
 use splitsum::error::{Error, Result};
 use splitsum_shaders::choice::Choice;
-use splitsum_shaders::shade::{DiffuseModel, FresnelForm, ShadeOptions, SpecularModel};
+use splitsum_shaders::shade::{self, DiffuseModel, FresnelForm, ShadeOptions, SpecularModel};
 use splitsum_shaders::tonemap::Tonemapper;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -26,6 +26,7 @@ D  diffuse model (Lambert, Oren-Nayar, Fresnel-weighted)
 S  specular model (Cook-Torrance, Phong, Blinn-Phong, none)
 F  Fresnel form (Schlick, spherical Gaussian)
 I  image-based light on/off      L  direct lights on/off
+K  prefiltered fetches per pixel (1, 2, 4, 8, 16: the shading ladder)
 + -  exposure ±½ stop            T  tone curve (ACES, Reinhard, clamp)
 [ ]  sky blur ±½ mip             R  reset the camera
 G  sphere grid on/off            M  model on/off
@@ -158,6 +159,8 @@ impl App {
                 "f" => o.fresnel = (o.fresnel + 1) % FresnelForm::ALL.len() as u32,
                 "i" => o.flags ^= ShadeOptions::IBL,
                 "l" => o.flags ^= ShadeOptions::DIRECT,
+                // The shading ladder: 1 → 2 → 4 → 8 → 16 → 1 fetches.
+                "k" => *o = o.with_fetches(if o.fetches() >= shade::MAX_FETCHES { 1 } else { 2 * o.fetches() }),
                 "+" | "=" => self.state.exposure *= std::f32::consts::SQRT_2,
                 "-" | "_" => self.state.exposure /= std::f32::consts::SQRT_2,
                 "t" => {

@@ -254,10 +254,16 @@ struct PointErrors {
 pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points: &Points) -> Result<Vec<Measurement>> {
     let device = crate::measurement::Device::of(backend);
     let mut rows = Vec::new();
+    // Methods that differ only in their shading share one bake (and its time).
+    let mut last: Option<(Settings, bake::BakedEnvironment, f64)> = None;
     for method in methods {
-        let start = Instant::now();
-        let baked = bake::bake_for_display(backend, env, &method.settings)?;
-        let ms = start.elapsed().as_secs_f64() * 1e3;
+        if last.as_ref().is_none_or(|(s, _, _)| *s != method.settings) {
+            let start = Instant::now();
+            let baked = bake::bake_for_display(backend, env, &method.settings)?;
+            last = Some((method.settings.clone(), baked, start.elapsed().as_secs_f64() * 1e3));
+        }
+        let (_, baked, ms) = last.as_ref().expect("baked above");
+        let ms = *ms;
         let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
         let opts = method.options();
         let dominant = usize::from(opts.flags & ShadeOptions::DOMINANT_DIRECTION != 0);
@@ -267,7 +273,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             .iter()
             .map(|p| {
                 let m = &p.material;
-                let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, opts.flags, p.n, p.v, m.roughness);
+                let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, opts, m, p.n, p.v);
                 let shown = shade::ibl(opts, m, p.n, p.v, s);
                 let exact = IblSample { prefiltered: vec(p.prefiltered[dominant]), irradiance: vec(p.irradiance), brdf: p.table[correlated] };
                 let split = shade::ibl(opts, m, p.n, p.v, exact);
@@ -284,9 +290,11 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
                 }
             })
             .collect();
+        let ladder = method.kind == Kind::Ladder;
         let row = |product: Product, errors: &[f64]| Measurement {
             samples: Some(method.settings.samples),
-            knob: Knob::Samples,
+            fetches: Some(opts.fetches()),
+            knob: if ladder { Knob::Fetches } else { Knob::Samples },
             ..device.row(product, method.kind, errors, Metric::RelativeLuminance)
         };
         // Over every point: the total (with the bake's time) and each part.

@@ -9,14 +9,14 @@
 use plotters::prelude::*;
 use splitsum::measured::Method;
 
-/// One curve: a method on a backend, its points (milliseconds, mean relative error).
+/// One curve: a method on a backend, its points (a cost, mean relative error).
 #[derive(Clone, Debug)]
 pub struct Series {
     /// The method (the colour).
     pub method: Method,
     /// `gpu` or `cpu` (the line style).
     pub backend: String,
-    /// (time in ms, mean relative error), in sweep order.
+    /// (cost: time in ms, or ns per pixel; mean relative error), in sweep order.
     pub points: Vec<(f64, f64)>,
 }
 
@@ -25,6 +25,8 @@ pub struct Series {
 pub struct Panel {
     /// The product (and, where it has several, which one).
     pub title: String,
+    /// What its horizontal axis measures.
+    pub x_label: String,
     /// Its curves.
     pub series: Vec<Series>,
 }
@@ -39,6 +41,8 @@ pub fn method_colour(m: Method) -> RGBColor {
         Method::FilteredSampling => RGBColor(86, 180, 233),
         Method::SmithSchlickTable => RGBColor(230, 159, 0),
         Method::LinearMipBlend => RGBColor(0, 0, 0),
+        Method::TableF0 => RGBColor(240, 228, 66),
+        Method::Ladder => RGBColor(170, 0, 90),
         Method::Sh9 => RGBColor(120, 94, 240),
         Method::ExactIngredients => RGBColor(90, 90, 90),
     }
@@ -139,7 +143,7 @@ fn draw_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel:
         .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
     chart
         .configure_mesh()
-        .x_desc("bake time (ms)")
+        .x_desc(panel.x_label.as_str())
         .y_desc("mean relative error")
         .x_label_formatter(&|v| sci(*v))
         .y_label_formatter(&|v| sci(*v))
@@ -162,6 +166,70 @@ fn draw_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel:
     chart.draw_series(LineSeries::new(front.clone(), grey.mix(0.5).stroke_width(1)))?;
     chart.draw_series(front.iter().map(|&p| Circle::new(p, 6, grey.stroke_width(1))))?;
     Ok(())
+}
+
+/// One curve of the shading ladder's figure: an environment or a set, its rungs.
+#[derive(Clone, Debug)]
+pub struct LadderCurve {
+    /// What it measures (the legend).
+    pub label: String,
+    /// (ns per shaded pixel, mean relative error, fetches), one per rung.
+    pub points: Vec<(f64, f64, u32)>,
+}
+
+/// One panel of the ladder's figure: its curves on one backend's costs.
+#[derive(Clone, Debug)]
+pub struct LadderPanel {
+    /// Which backend's costs.
+    pub title: String,
+    /// Its curves.
+    pub curves: Vec<LadderCurve>,
+}
+
+/// The shading ladder's figure as an SVG document: error against ns per shaded pixel, a
+/// panel per backend, each rung's point labelled with its fetches.
+pub fn ladder(panels: &[LadderPanel]) -> Result<String, Error> {
+    const PALETTE: [RGBColor; 5] = [RGBColor(0, 114, 178), RGBColor(86, 180, 233), RGBColor(0, 158, 115), RGBColor(213, 94, 0), RGBColor(230, 159, 0)];
+    let (panel_w, panel_h) = (460u32, 340u32);
+    let size = (panel_w * panels.len().max(1) as u32, panel_h);
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        root.fill(&WHITE)?;
+        for (panel, area) in panels.iter().zip(root.split_evenly((1, panels.len().max(1)))) {
+            let all: Vec<(f64, f64)> = panel.curves.iter().flat_map(|c| c.points.iter().map(|p| (p.0, p.1))).collect();
+            let xr = decade_range(all.iter().map(|p| p.0));
+            let yr = decade_range(all.iter().map(|p| p.1));
+            let mut chart = ChartBuilder::on(&area)
+                .caption(&panel.title, ("sans-serif", 15))
+                .margin(8)
+                .x_label_area_size(34)
+                .y_label_area_size(52)
+                .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
+            chart
+                .configure_mesh()
+                .x_desc("ns per shaded pixel")
+                .y_desc("mean relative error")
+                .x_label_formatter(&|v| sci(*v))
+                .y_label_formatter(&|v| sci(*v))
+                .light_line_style(RGBColor(235, 235, 235))
+                .label_style(("sans-serif", 12))
+                .axis_desc_style(("sans-serif", 12))
+                .draw()?;
+            for (i, curve) in panel.curves.iter().enumerate() {
+                let c = PALETTE[i % PALETTE.len()];
+                let pts: Vec<(f64, f64)> = curve.points.iter().map(|p| (p.0, p.1)).filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite()).collect();
+                chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))?.label(curve.label.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+                chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))?;
+                chart.draw_series(
+                    curve.points.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0).map(|&(x, y, k)| Text::new(format!("{k}"), (x, y), ("sans-serif", 11).into_font())),
+                )?;
+            }
+            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(RGBColor(200, 200, 200)).label_font(("sans-serif", 11)).draw()?;
+        }
+        root.present()?;
+    }
+    Ok(svg)
 }
 
 /// A horizontal false-colour scale (`colour(t)` for `t` in 0..1) labelled `ticks`

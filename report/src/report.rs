@@ -126,8 +126,15 @@ impl Sweep {
             Method { kind: Kind::MultipleScattering, settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
             Method { kind: Kind::FilteredSampling, settings: default.clone(), flags: flags | ShadeOptions::FILTERED_SAMPLING },
             Method { kind: Kind::LinearMipBlend, settings: default.clone(), flags: flags & !ShadeOptions::LOG_MIP_BLEND },
-            Method { kind: Kind::SmithSchlickTable, settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default }, flags },
+            Method { kind: Kind::TableF0, settings: default.clone(), flags: flags | ShadeOptions::TABLE_F0 },
+            Method { kind: Kind::SmithSchlickTable, settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default.clone() }, flags },
         ]);
+        // The shading ladder: the defaults' bake read with 2, 4, 8 and 16 fetches.
+        let base = ShadeOptions { flags, ..ShadeOptions::DEFAULT };
+        for rung in 1..shade::LADDER_RUNGS {
+            let flags = base.with_fetches(1 << rung).flags;
+            methods.push(Method { kind: Kind::Ladder, settings: default.clone(), flags });
+        }
         methods
     }
 
@@ -215,12 +222,15 @@ pub struct Sets {
     pub dir: std::path::PathBuf,
     /// Only the environments present (and the generated ones), for a quick report.
     pub present_only: bool,
+    /// Only this set (to iterate on the tuning set without looking at the held-out one).
+    pub only: Option<splitsum::measured::Set>,
 }
 
 /// Runs the report's sweeps of `env` on `backends` (and the measure over `sets`, if
-/// given, on the first backend), writes the files into `dir`, and returns the
-/// measurements.
-pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, sets: Option<&Sets>, dir: &Path) -> Result<Vec<Measurement>> {
+/// given, on the first backend), writes the files into `dir` with the shading ladder's
+/// `costs` (`Product::ShadingCost` rows, timed by the renderer's owner) beside its errors,
+/// and returns the measurements.
+pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, sets: Option<&Sets>, costs: &[Measurement], dir: &Path) -> Result<Vec<Measurement>> {
     if let Some(s) = sets
         && !s.present_only
     {
@@ -266,9 +276,12 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, s
         rows.extend(crate::accuracy::measure(backend, env, &methods, &points)?);
     }
     if let Some(sets) = sets {
-        let keep = |m: &crate::sets::Member| match m.source {
-            crate::sets::Source::File(f) => !sets.present_only || sets.dir.join(f).exists(),
-            _ => true,
+        let keep = |m: &crate::sets::Member| {
+            sets.only.is_none_or(|s| s == m.set)
+                && match m.source {
+                    crate::sets::Source::File(f) => !sets.present_only || sets.dir.join(f).exists(),
+                    _ => true,
+                }
         };
         rows.extend(crate::sets::run(&backends[0], &sets.dir, sweep.accuracy_source, sweep.accuracy_points, |n| sweep.set_methods(n), keep)?);
     }
@@ -286,6 +299,7 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, s
         let exact = reference::Environment::new(cube.level(0), cube.layout.size);
         maps.push((what, crate::surface::error_map(&baked, &exact)));
     }
+    rows.extend_from_slice(costs);
     let _step = splitsum::progress::step("report: writing report.html, report.md, report.csv and the figures", None);
     write_outputs(dir, name, backends, sweep, &rows, &maps)?;
     Ok(rows)
@@ -502,7 +516,7 @@ fn shaded_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, 
                 .iter()
                 .filter(|p| in_view(p, (lo, hi)))
                 .map(|p| {
-                    let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, ShadeOptions::DEFAULT.flags, p.n, p.v, p.material.roughness);
+                    let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, ShadeOptions::DEFAULT, &p.material, p.n, p.v);
                     rel(shade::ibl(ShadeOptions::DEFAULT, &p.material, p.n, p.v, s), p.full)
                 })
                 .collect();
@@ -553,7 +567,7 @@ pub fn panels(rows: &[Measurement]) -> Vec<crate::plot::Panel> {
         let k = match panels.iter().position(|p| p.title == title) {
             Some(k) => k,
             None => {
-                panels.push(crate::plot::Panel { title, series: vec![] });
+                panels.push(crate::plot::Panel { title, x_label: "bake time (ms)".into(), series: vec![] });
                 panels.len() - 1
             }
         };
@@ -598,7 +612,7 @@ type Table = (String, [&'static str; 8], Vec<[String; 8]>);
 
 /// The report's tables: one per product, rows in measurement order.
 fn tables(rows: &[Measurement]) -> Vec<Table> {
-    let mut products: Vec<Product> = rows.iter().filter(|r| r.set.is_none()).map(|r| r.product).collect();
+    let mut products: Vec<Product> = rows.iter().filter(|r| r.set.is_none() && r.product != Product::ShadingCost).map(|r| r.product).collect();
     products.sort();
     products.dedup();
     let header = ["method", "backend", "setting", "band", "part", "time (ms)", "mean error", "max error"];
@@ -705,6 +719,105 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
     tables
 }
 
+/// What the shading ladder is, in the report.
+const LADDER_NOTE: &str = "The shading ladder: the split sum's one prefiltered fetch, then 2 to 16 fetches of filtered importance sampling of the true GGX lobe over the prefiltered mips (shade::lobe_radiance), used below n·v 0.7. Shaded colour against the full reflectance integral (mean relative luminance error, the largest point in brackets), against what a shaded pixel costs: ns per pixel of a sphere in the default view, direct lights included (a frame with the spheres less one without, best of three).";
+
+/// The rungs of the ladder present in `rows`, in order.
+fn rungs(rows: &[Measurement]) -> Vec<u32> {
+    let mut k: Vec<u32> = rows.iter().filter(|r| r.product == Product::ShadingCost).filter_map(|r| r.fetches).collect();
+    k.sort();
+    k.dedup();
+    k
+}
+
+/// The shaded colour's rows of the rung with `fetches` (the defaults at their own sample
+/// count for one fetch, the ladder above), part total.
+fn rung_rows(rows: &[Measurement], fetches: u32) -> impl Iterator<Item = &Measurement> {
+    let samples = Settings::default().samples;
+    rows.iter().filter(move |r| {
+        r.product == Product::ShadedColour
+            && r.part == Part::Total
+            && r.fetches == Some(fetches)
+            && r.roughness_lo.is_none()
+            && r.near_sun.is_none()
+            && match r.method {
+                Method::Defaults => fetches == 1 && r.samples == Some(samples) && r.knob == Knob::Samples,
+                Method::Ladder => true,
+                _ => false,
+            }
+    })
+}
+
+/// The ladder's table: per rung, its cost on each backend and its error on the report's
+/// environment and over each set, all points and per `n·v` band.
+fn ladder_table(rows: &[Measurement]) -> Option<Table> {
+    let rungs = rungs(rows);
+    if rungs.is_empty() {
+        return None;
+    }
+    let cost = |k: u32, engine: &str| {
+        rows.iter()
+            .find(|r| r.product == Product::ShadingCost && r.fetches == Some(k) && r.backend == engine)
+            .and_then(|r| r.ns_per_pixel)
+            .map_or("-".into(), |ns| format!("{ns:.0}"))
+    };
+    let first = rows.iter().find(|r| r.product == Product::ShadedColour && r.set.is_none() && !r.backend.is_empty()).map(|r| r.backend.clone());
+    let cells = rungs
+        .iter()
+        .map(|&k| {
+            let own = |band: Option<f32>| over_environments(rung_rows(rows, k).filter(|r| r.set.is_none() && Some(&r.backend) == first.as_ref() && r.nv_hi == band));
+            let set = |s: crate::measurement::Set, band: Option<f32>| over_environments(rung_rows(rows, k).filter(|r| r.set == Some(s) && r.nv_hi == band));
+            [
+                format!("{k}"),
+                cost(k, "gpu"),
+                cost(k, "cpu"),
+                own(None),
+                own(Some(0.1)),
+                set(crate::measurement::Set::Tuning, None),
+                set(crate::measurement::Set::HeldOut, None),
+                set(crate::measurement::Set::HeldOut, Some(0.1)),
+            ]
+        })
+        .collect();
+    let header = ["fetches", "ns/pixel, GPU", "ns/pixel, CPU", "this environment", "its n·v ≤ 0.1", "tuning set", "held-out set", "held-out n·v ≤ 0.1"];
+    Some(("shading ladder: shaded colour against cost".to_string(), header, cells))
+}
+
+/// The ladder's figure: error against ns per pixel, a panel per backend's cost, a curve
+/// per environment or set (its points the rungs, 1 to 16 fetches).
+pub fn ladder_panels(rows: &[Measurement]) -> Vec<crate::plot::LadderPanel> {
+    use crate::measurement::Set;
+    let rungs = rungs(rows);
+    let mut panels = Vec::new();
+    for engine in ["gpu", "cpu"] {
+        let ns = |k: u32| rows.iter().find(|r| r.product == Product::ShadingCost && r.fetches == Some(k) && r.backend == engine).and_then(|r| r.ns_per_pixel);
+        if rungs.iter().all(|&k| ns(k).is_none()) {
+            continue;
+        }
+        let mut curves = Vec::new();
+        for (label, set, band) in [
+            ("this environment", None, None),
+            ("this environment, n·v ≤ 0.1", None, Some(0.1)),
+            ("tuning set", Some(Set::Tuning), None),
+            ("held-out set", Some(Set::HeldOut), None),
+            ("held-out set, n·v ≤ 0.1", Some(Set::HeldOut), Some(0.1)),
+        ] {
+            let points: Vec<(f64, f64, u32)> = rungs
+                .iter()
+                .filter_map(|&k| {
+                    let errs: Vec<f64> = rung_rows(rows, k).filter(|r| r.set == set && r.nv_hi == band && (set.is_some() || r.backend == engine)).map(|r| r.mean_error).collect();
+                    (!errs.is_empty()).then(|| Some((ns(k)?, errs.iter().sum::<f64>() / errs.len() as f64, k)))?
+                })
+                .collect();
+            if !points.is_empty() {
+                curves.push(crate::plot::LadderCurve { label: label.to_string(), points });
+            }
+        }
+        panels.push(crate::plot::LadderPanel { title: format!("shading ladder, cost on the {}", if engine == "gpu" { "GPU" } else { "CPU" }), curves });
+    }
+    panels
+}
+
 fn html_escape(s: &str) -> String {
     s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
 }
@@ -721,6 +834,10 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         for (kind, rgb) in [("splitsum", &map.splitsum), ("exact", &map.exact), ("error", &map.error)] {
             files::write_png(&dir.join(picture(k, kind)), map.width, map.height, rgb)?;
         }
+    }
+    let ladder = ladder_table(rows);
+    if ladder.is_some() {
+        files::write_atomic(&dir.join("ladder.svg"), |w| svg(w, crate::plot::ladder(&ladder_panels(rows))))?;
     }
     files::write_atomic(&dir.join("surface_scale.svg"), |w| {
         svg(w, crate::plot::colour_scale("relative luminance error", crate::surface::false_colour, &crate::surface::scale_ticks()))
@@ -750,6 +867,12 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         let _ = writeln!(md, "| {} | ![]({}) | ![]({}) | ![]({}) |", caption(what, map), picture(k, "splitsum"), picture(k, "exact"), picture(k, "error"));
     }
     let _ = writeln!(md, "\n![scale](surface_scale.svg)");
+    if let Some((title, header, cells)) = &ladder {
+        let _ = writeln!(md, "\n## {title}\n\n{LADDER_NOTE}\n\n![the shading ladder](ladder.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
+        for c in cells {
+            let _ = writeln!(md, "| {} |", c.join(" | "));
+        }
+    }
     if !set_tables.is_empty() {
         let _ = writeln!(md, "\n## Tuning and held-out sets\n\n{SETS_NOTE}");
     }
@@ -786,6 +909,19 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         );
     }
     let _ = writeln!(html, "<img src=\"surface_scale.svg\" alt=\"error scale\">");
+    if let Some((title, header, cells)) = &ladder {
+        let _ = writeln!(
+            html,
+            "<h2 id=\"ladder\">{}</h2>\n<p>{}</p>\n<figure><img src=\"ladder.svg\" alt=\"error against ns per shaded pixel, one point per rung\"></figure>\n<table><tr>{}</tr>",
+            html_escape(title),
+            html_escape(LADDER_NOTE),
+            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
+        );
+        for c in cells {
+            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
+        }
+        let _ = writeln!(html, "</table>");
+    }
     if !set_tables.is_empty() {
         let _ = writeln!(html, "<h2>Tuning and held-out sets</h2>\n<p>{}</p>", html_escape(SETS_NOTE));
     }

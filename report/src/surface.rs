@@ -89,13 +89,13 @@ pub fn error_map(baked: &BakedEnvironment, env: &reference::Environment) -> Erro
     }
     let v = Vec3::Z;
     let opts = ShadeOptions::DEFAULT;
-    let flags = opts.flags & !(ShadeOptions::IBL | ShadeOptions::DIRECT);
+    let opts = ShadeOptions { flags: (opts.flags & !ShadeOptions::DIRECT) | ShadeOptions::IBL, ..opts };
     let shape = baked.shape();
     let shaded: Vec<(Vec3, [f64; 3])> = points
         .par_iter()
         .map(|(_, _, m, n)| {
-            let s = shade::ibl_sample(shape, &baked.specular.texels, &baked.irradiance.texels, &baked.lut.texels, flags, *n, v, m.roughness);
-            let got = shade::ibl(ShadeOptions { flags: flags | ShadeOptions::IBL, ..opts }, m, *n, v, s);
+            let s = shade::ibl_sample(shape, &baked.specular.texels, &baked.irradiance.texels, &baked.lut.texels, opts, m, *n, v);
+            let got = shade::ibl(opts, m, *n, v, s);
             let want = env.shade(arr(*n), arr(v), arr(m.base_color), m.metallic as f64, m.roughness as f64, reference::Smith::Correlated);
             (got, want)
         })

@@ -5,6 +5,8 @@
 //! - GGX half-vector sampling with density `D(h)·(n·h)` (Walter et al. 2007, "Microfacet
 //!   Models for Refraction through Rough Surfaces", eq. 35–36; Karis 2013, "Real Shading
 //!   in Unreal Engine 4", `ImportanceSampleGGX`).
+//! - GGX visible-normal sampling, density `G₁(v)·max(0, v·h)·D(h)/(n·v)` (Heitz 2018,
+//!   "Sampling the GGX Distribution of Visible Normals", JCGT 7(4), listing 1).
 //! - An orthonormal frame around a unit normal that stays finite at both poles (Duff et
 //!   al. 2017, "Building an Orthonormal Basis, Revisited", JCGT 6(1)).
 
@@ -70,6 +72,30 @@ pub fn sample_ggx(xi: Vec2, alpha: f32, n: Vec3) -> Vec3 {
     let h = sample_ggx_tangent(xi, alpha);
     let (t, b) = orthonormal_basis(n);
     t * h.x + b * h.y + n * h.z
+}
+
+/// A GGX half vector drawn from the normals visible from `v` (tangent space, `z` the
+/// normal, `v.z > 0`), for the unit-square point `xi` and GGX width `alpha`: Heitz 2018,
+/// listing 1, isotropic. The view is stretched to the hemisphere configuration
+/// (`v_h = normalize(α v.x, α v.y, v.z)`), a point of the unit disk is drawn (radius
+/// `√xi.x`, angle `2π·xi.y`), warped onto the visible half of the projected hemisphere
+/// (`t₂ ← (1 − s)√(1 − t₁²) + s t₂`, `s = (1 + v_h.z)/2`), lifted onto it, and unstretched.
+/// Density `G₁(v) max(0, v·h) D(h) / v.z`; each sample's reflection `l` has density
+/// `G₁(v) D(h) / (4 v.z)`. `α = 0` gives `(0, 0, 1)`; a point on the disk's rim cannot
+/// give a zero vector (the normalisation falls back to the normal).
+#[inline]
+pub fn sample_vndf_tangent(xi: Vec2, alpha: f32, v: Vec3) -> Vec3 {
+    let vh = normalize_or(Vec3::new(alpha * v.x, alpha * v.y, v.z), Vec3::Z);
+    let len2 = vh.x * vh.x + vh.y * vh.y;
+    let t1 = if len2 > 1e-20 { Vec3::new(-vh.y, vh.x, 0.0) * (1.0 / math::sqrt(len2)) } else { Vec3::X };
+    let t2 = vh.cross(t1);
+    let radius = math::sqrt(xi.x);
+    let (sin_phi, cos_phi) = math::sin_cos_turns(xi.y);
+    let p1 = radius * cos_phi;
+    let s = 0.5 * (1.0 + vh.z);
+    let p2 = (1.0 - s) * math::sqrt(math::max(1.0 - p1 * p1, 0.0)) + s * (radius * sin_phi);
+    let nh = t1 * p1 + t2 * p2 + vh * math::sqrt(math::max(1.0 - p1 * p1 - p2 * p2, 0.0));
+    normalize_or(Vec3::new(alpha * nh.x, alpha * nh.y, math::max(nh.z, 0.0)), Vec3::Z)
 }
 
 /// A cosine-distributed direction in tangent space (`z` up), density `cos θ / π`

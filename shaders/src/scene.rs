@@ -176,7 +176,7 @@ fn step(i: u32, n: u32) -> f32 {
 pub fn shade_point(frame: &Frame, opts: ShadeOptions, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], m: &Material, p: Vec3, n: Vec3, v: Vec3) -> Vec3 {
     let mut color = m.emissive;
     if opts.flags & ShadeOptions::IBL != 0 {
-        let s = shade::ibl_sample(frame.shape, specular, irradiance, table, opts.flags, n, v, m.roughness);
+        let s = shade::ibl_sample(frame.shape, specular, irradiance, table, opts, m, n, v);
         color += shade::ibl(opts, m, n, v, s);
     }
     if opts.flags & ShadeOptions::DIRECT != 0 {

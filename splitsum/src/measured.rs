@@ -21,6 +21,9 @@ pub enum Product {
     ShadedColour,
     /// The prefiltered radiance a renderer reads at any roughness (the mips blended).
     PrefilteredLookup,
+    /// What shading a pixel costs (`ns_per_pixel`) at a rung of the shading ladder
+    /// (`fetches`); its errors are the shaded colour's rows of the same rung.
+    ShadingCost,
 }
 
 impl Product {
@@ -33,6 +36,7 @@ impl Product {
             Product::Irradiance => "irradiance",
             Product::ShadedColour => "shaded colour",
             Product::PrefilteredLookup => "prefiltered lookup, any roughness",
+            Product::ShadingCost => "shading cost per pixel",
         }
     }
 }
@@ -56,6 +60,10 @@ pub enum Method {
     SmithSchlickTable,
     /// The defaults, blending between mips linearly (before the log-luminance blend).
     LinearMipBlend,
+    /// The defaults reading the table as `F₀·A + B` (`ShadeOptions::TABLE_F0`).
+    TableF0,
+    /// The defaults with the shading ladder's `fetches` prefiltered fetches per pixel.
+    Ladder,
     /// SH9 in place of the irradiance convolution.
     Sh9,
     /// The split sum from exact ingredients: the error of the approximation itself.
@@ -73,6 +81,8 @@ impl Method {
             Method::FilteredSampling => "defaults + filtered sampling",
             Method::SmithSchlickTable => "defaults, Smith-Schlick table",
             Method::LinearMipBlend => "defaults, linear mip blend",
+            Method::TableF0 => "defaults, table read as F0*A + B",
+            Method::Ladder => "shading ladder",
             Method::Sh9 => "SH9",
             Method::ExactIngredients => "exact ingredients (split sum alone)",
         }
@@ -108,6 +118,8 @@ pub enum Knob {
     SourceSize,
     /// A whole quality level (`samples` holds its sample count).
     Quality,
+    /// Prefiltered fetches per shaded pixel (`fetches`).
+    Fetches,
     /// Nothing: one measurement.
     None,
 }
@@ -122,6 +134,8 @@ pub enum Set {
     /// Environments no choice looked at.
     HeldOut,
 }
+
+splitsum_shaders::choice!(Set: Tuning => "tuning", HeldOut => "held-out");
 
 impl Set {
     /// Its name in the report.
@@ -172,6 +186,10 @@ pub struct Measurement {
     pub source_size: Option<u32>,
     /// Source-mip bias of the prefilter.
     pub bias: Option<f32>,
+    /// Prefiltered fetches per shaded pixel (the shading ladder's rung).
+    pub fetches: Option<u32>,
+    /// Shading time per pixel in nanoseconds (the shading ladder, timed on a frame).
+    pub ns_per_pixel: Option<f64>,
     /// Roughness band `[lo, hi)` of the points (or the level's roughness, `lo = hi`).
     pub roughness_lo: Option<f32>,
     /// Upper end of the roughness band.
@@ -212,6 +230,8 @@ impl Measurement {
             size: None,
             source_size: None,
             bias: None,
+            fetches: None,
+            ns_per_pixel: None,
             roughness_lo: None,
             roughness_hi: None,
             nv_lo: None,
@@ -231,6 +251,7 @@ impl Measurement {
             Knob::Size => self.size.map(f64::from),
             Knob::Bias => self.bias.map(f64::from),
             Knob::SourceSize => self.source_size.map(f64::from),
+            Knob::Fetches => self.fetches.map(f64::from),
             Knob::None => None,
         }
     }
@@ -249,6 +270,11 @@ impl Measurement {
         }
         if let Some(b) = self.bias {
             parts.push(format!("bias {b}"));
+        }
+        match self.fetches {
+            Some(1) => parts.push("1 fetch".into()),
+            Some(k) => parts.push(format!("{k} fetches")),
+            None => {}
         }
         if parts.is_empty() { "-".into() } else { parts.join(", ") }
     }

@@ -1,6 +1,7 @@
 //! `runner report`: error against run time of every product and of the shaded colour.
 
 use super::*;
+use splitsum::measured::{Knob, Measurement, Method, Metric, Product, Set};
 
 #[derive(Args)]
 pub(super) struct ReportArgs {
@@ -23,6 +24,9 @@ pub(super) struct ReportArgs {
     /// environments` fetches them there).
     #[arg(long, default_value = "target/environments", requires = "sets")]
     environments: PathBuf,
+    /// Measure only this set: iterate on the tuning set without looking at the held-out one.
+    #[arg(long, value_parser = choice::<Set>(), requires = "sets")]
+    set: Option<Set>,
 }
 
 pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
@@ -38,8 +42,9 @@ pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
     let sweep = if args.quick { crate::report::Sweep::quick() } else { crate::report::Sweep::full() };
     let start = Instant::now();
     let out = files::OutputDir::begin(&args.out, "--out")?;
-    let sets = args.sets.then(|| crate::report::Sets { dir: args.environments.clone(), present_only: args.quick });
-    let rows = crate::report::run(&env, &name, &backends, &sweep, sets.as_ref(), out.path())?;
+    let sets = args.sets.then(|| crate::report::Sets { dir: args.environments.clone(), present_only: args.quick, only: args.set });
+    let costs = ladder_costs(&env, &backends, args.quick)?;
+    let rows = crate::report::run(&env, &name, &backends, &sweep, sets.as_ref(), &costs, out.path())?;
     out.commit()?;
     println!("{} measurements in {:.1} s", rows.len(), start.elapsed().as_secs_f64());
     for (panel, r) in crate::report::best_per_ms(&rows) {
@@ -48,4 +53,32 @@ pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
     }
     println!("wrote {0}/report.html (open it in a browser), report.md, report.csv and the figures", args.out.display());
     Ok(())
+}
+
+/// What each rung of the shading ladder costs per shaded pixel on each backend (the
+/// renderer is the display's, which the report crate does not depend on): the default bake
+/// of `env` at 128² (64² with `quick`), frames of 256² (64²), best of three (one).
+fn ladder_costs(env: &environment::Environment, backends: &[Backend], quick: bool) -> anyhow::Result<Vec<Measurement>> {
+    use splitsum_shaders::shade::{LADDER_RUNGS, ShadeOptions};
+    let _step = crate::progress::step("report: the shading ladder's cost per pixel", None);
+    let (size, frame, repeats) = if quick { (64, 64, 1) } else { (128, 256, 3) };
+    let mut rows = Vec::new();
+    for backend in backends {
+        let baked = crate::bake::bake_for_display(backend, env, &crate::settings::Settings { size, ..crate::settings::Settings::default() })?;
+        let device = splitsum_report::measurement::Device::of(backend);
+        for rung in 0..LADDER_RUNGS {
+            let fetches = 1 << rung;
+            let ns = crate::render::shading_ns_per_pixel(backend, &baked, ShadeOptions::DEFAULT.with_fetches(fetches), frame, repeats)?;
+            let method = if fetches == 1 { Method::Defaults } else { Method::Ladder };
+            rows.push(Measurement {
+                knob: Knob::Fetches,
+                fetches: Some(fetches),
+                ns_per_pixel: Some(ns),
+                mean_error: f64::NAN,
+                max_error: f64::NAN,
+                ..device.row(Product::ShadingCost, method, &[], Metric::RelativeLuminance)
+            });
+        }
+    }
+    Ok(rows)
 }
