@@ -297,10 +297,13 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             knob: if ladder { Knob::Fetches } else { Knob::Samples },
             ..device.row(product, method.kind, errors, Metric::RelativeLuminance)
         };
-        // Over every point: the total (with the bake's time) and each part.
-        for k in 0..4 {
+        // Over every point: the total (with the bake's time) and each part. The ladder's
+        // error has no split-sum share to split off (it reads no split sum): total only.
+        let parts = if ladder { 1 } else { 4 };
+        for k in 0..parts {
             let all: Vec<f64> = per_point.iter().map(|p| p.parts[k].1).collect();
-            let time_ms = (k == 0).then_some(ms);
+            // The ladder costs shading time, not bake time (`Product::ShadingCost`).
+            let time_ms = (k == 0 && !ladder).then_some(ms);
             rows.push(Measurement { part: per_point[0].parts[k].0, time_ms, ..row(Product::ShadedColour, &all) });
         }
         // By roughness band, then by view band, each split into its parts.
@@ -310,7 +313,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             v.sort_by(|a, b| a.0.total_cmp(&b.0));
             v.dedup();
         }
-        for k in 0..4 {
+        for k in 0..parts {
             let part = per_point[0].parts[k].0;
             for &(lo, hi) in &roughness {
                 let e: Vec<f64> = per_point.iter().filter(|p| roughness_band(p.roughness) == (lo, hi)).map(|p| p.parts[k].1).collect();
@@ -320,6 +323,9 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
                 let e: Vec<f64> = per_point.iter().filter(|p| view_band(p.n_dot_v) == (lo, hi)).map(|p| p.parts[k].1).collect();
                 rows.push(Measurement { part, nv_lo: Some(lo), nv_hi: Some(hi), ..row(Product::ShadedColour, &e) });
             }
+        }
+        if ladder {
+            continue; // its lookups are the defaults': the same bake, read the same way
         }
         // The prefiltered radiance a renderer reads at any roughness.
         let lookups: Vec<(f32, bool, f64)> = points

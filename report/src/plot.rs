@@ -43,6 +43,8 @@ pub fn method_colour(m: Method) -> RGBColor {
         Method::LinearMipBlend => RGBColor(0, 0, 0),
         Method::TableF0 => RGBColor(240, 228, 66),
         Method::Ladder => RGBColor(170, 0, 90),
+        Method::KhronosBevyLookup => RGBColor(120, 120, 0),
+        Method::FilamentLookup => RGBColor(0, 120, 120),
         Method::Sh9 => RGBColor(120, 94, 240),
         Method::ExactIngredients => RGBColor(90, 90, 90),
     }
@@ -199,19 +201,19 @@ pub fn ladder(panels: &[LadderPanel]) -> Result<String, Error> {
         for (panel, area) in panels.iter().zip(root.split_evenly((1, panels.len().max(1)))) {
             let all: Vec<(f64, f64)> = panel.curves.iter().flat_map(|c| c.points.iter().map(|p| (p.0, p.1))).collect();
             let xr = decade_range(all.iter().map(|p| p.0));
-            let yr = decade_range(all.iter().map(|p| p.1));
+            let top = all.iter().map(|p| p.1).filter(|e| e.is_finite()).fold(0.0f64, f64::max).max(1e-3) * 1.15;
             let mut chart = ChartBuilder::on(&area)
                 .caption(&panel.title, ("sans-serif", 15))
                 .margin(8)
                 .x_label_area_size(34)
                 .y_label_area_size(52)
-                .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
+                .build_cartesian_2d(xr.log_scale(), 0.0..top)?;
             chart
                 .configure_mesh()
                 .x_desc("ns per shaded pixel")
                 .y_desc("mean relative error")
                 .x_label_formatter(&|v| sci(*v))
-                .y_label_formatter(&|v| sci(*v))
+                .y_label_formatter(&|v| format!("{:.0} %", 100.0 * v))
                 .light_line_style(RGBColor(235, 235, 235))
                 .label_style(("sans-serif", 12))
                 .axis_desc_style(("sans-serif", 12))

@@ -23,7 +23,7 @@ use splitsum::bake;
 use splitsum::environment::Environment;
 use splitsum::error::Result;
 use splitsum::files;
-use splitsum::settings::{Settings, level_of_size};
+use splitsum::settings::{Settings, Target, level_of_size};
 use splitsum::texture::Cube;
 use splitsum_reference as reference;
 use splitsum_shaders::brdf::microfacet::Masking;
@@ -127,13 +127,19 @@ impl Sweep {
             Method { kind: Kind::FilteredSampling, settings: default.clone(), flags: flags | ShadeOptions::FILTERED_SAMPLING },
             Method { kind: Kind::LinearMipBlend, settings: default.clone(), flags: flags & !ShadeOptions::LOG_MIP_BLEND },
             Method { kind: Kind::TableF0, settings: default.clone(), flags: flags | ShadeOptions::TABLE_F0 },
-            Method { kind: Kind::SmithSchlickTable, settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default.clone() }, flags },
         ]);
         // The shading ladder: the defaults' bake read with 2, 4, 8 and 16 fetches.
         let base = ShadeOptions { flags, ..ShadeOptions::DEFAULT };
         for rung in 1..shade::LADDER_RUNGS {
             let flags = base.with_fetches(1 << rung).flags;
             methods.push(Method { kind: Kind::Ladder, settings: default.clone(), flags });
+        }
+        methods.push(Method { kind: Kind::SmithSchlickTable, settings: Settings { lut_masking: Some(Masking::SmithSchlick), ..default.clone() }, flags });
+        // Each engine target's levels, read as its engine reads them (linear between mips).
+        for (kind, target) in [(Kind::KhronosBevyLookup, Target::Khronos), (Kind::FilamentLookup, Target::Filament)] {
+            let fixed = target.fixed();
+            let settings = Settings { mapping: fixed.mapping, mips: fixed.mips.map(|m| m(src)), ..default.clone() };
+            methods.push(Method { kind, settings, flags: flags & !ShadeOptions::LOG_MIP_BLEND });
         }
         methods
     }
@@ -665,21 +671,27 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
         return vec![];
     }
     let no_band = |r: &Measurement| r.roughness_lo.is_none() && r.nv_lo.is_none() && r.near_sun.is_none();
-    let mut methods: Vec<(Method, u32)> = set_rows.iter().map(|r| (r.method, r.samples.unwrap_or(0))).collect();
+    // A method is its kind, its sample count and its fetches (the ladder's rungs apart).
+    type Key = (Method, u32, u32);
+    let key = |r: &Measurement| -> Key { (r.method, r.samples.unwrap_or(0), r.fetches.unwrap_or(1)) };
+    let mut methods: Vec<Key> = set_rows.iter().map(|r| key(r)).collect();
     methods.sort();
     methods.dedup();
     let mut tables = Vec::new();
     for set in [Set::Tuning, Set::HeldOut] {
         let mut envs: Vec<&str> = set_rows.iter().filter(|r| r.set == Some(set)).map(|r| r.environment.as_str()).collect();
         envs.dedup();
-        let of = |m: (Method, u32)| set_rows.iter().copied().filter(move |r| r.set == Some(set) && (r.method, r.samples.unwrap_or(0)) == m);
+        let of = |m: Key| set_rows.iter().copied().filter(move |r| r.set == Some(set) && key(r) == m);
         let cells = methods
             .iter()
             .map(|&m| {
                 let shaded = |part: Part| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == part && no_band(r)));
                 let view = |hi: f32| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
                 [
-                    format!("{}, {} samples", m.0.title(), m.1),
+                    match m.2 {
+                        1 => format!("{}, {} samples", m.0.title(), m.1),
+                        k => format!("{}, {k} fetches", m.0.title()),
+                    },
                     shaded(Part::Total),
                     view(0.1),
                     view(0.3),
@@ -693,13 +705,13 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
         let header = ["method", "shaded colour", "n·v ≤ 0.1", "0.1–0.3", "0.3–0.6", "0.6–1", "(a) bake's share", "prefiltered lookup"];
         tables.push((format!("{}: {}", set.title(), envs.join(", ")), header, cells));
     }
-    let defaults = (Method::Defaults, Settings::default().samples);
+    let defaults: Key = (Method::Defaults, Settings::default().samples, 1);
     let mut envs: Vec<(&str, Set)> = set_rows.iter().map(|r| (r.environment.as_str(), r.set.expect("set rows"))).collect();
     envs.dedup();
     let cells = envs
         .iter()
         .map(|&(env, set)| {
-            let of = |m: (Method, u32)| set_rows.iter().copied().filter(move |r| r.environment == env && (r.method, r.samples.unwrap_or(0)) == m);
+            let of = |m: Key| set_rows.iter().copied().filter(move |r| r.environment == env && key(r) == m);
             let shaded = |m, part: Part| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == part && no_band(r)));
             let view = |hi: f32| over_environments(of(defaults).filter(|r| r.product == Product::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
             [
@@ -710,7 +722,7 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
                 view(0.1),
                 shaded(defaults, Part::Bake),
                 shaded(defaults, Part::SplitSum),
-                shaded((Method::Seed, 1024), Part::Total),
+                shaded((Method::Seed, 1024, 1), Part::Total),
             ]
         })
         .collect();

@@ -64,6 +64,12 @@ pub enum Method {
     TableF0,
     /// The defaults with the shading ladder's `fetches` prefiltered fetches per pixel.
     Ladder,
+    /// The Khronos and Bevy targets' levels (roughness `m/(M−1)`, `⌊log₂ size⌋` mips) read
+    /// as their engines read them: trilinear, linear between mips, at mip `r·(M−1)`.
+    KhronosBevyLookup,
+    /// The Filament target's levels (`1 − √(1 − m/(M−1))`, down to 16²) read as Filament
+    /// reads them: trilinear at mip `(M−1)·r(2 − r)`.
+    FilamentLookup,
     /// SH9 in place of the irradiance convolution.
     Sh9,
     /// The split sum from exact ingredients: the error of the approximation itself.
@@ -83,6 +89,8 @@ impl Method {
             Method::LinearMipBlend => "defaults, linear mip blend",
             Method::TableF0 => "defaults, table read as F0*A + B",
             Method::Ladder => "shading ladder",
+            Method::KhronosBevyLookup => "khronos/bevy target, engine's trilinear read",
+            Method::FilamentLookup => "filament target, engine's trilinear read",
             Method::Sh9 => "SH9",
             Method::ExactIngredients => "exact ingredients (split sum alone)",
         }
