@@ -734,30 +734,44 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
 /// What the shading ladder is, in the report.
 const LADDER_NOTE: &str = "The shading ladder: the split sum's one prefiltered fetch, then 2 to 16 fetches of filtered importance sampling of the true GGX lobe over the prefiltered mips (shade::lobe_radiance), used below n·v 0.7. Shaded colour against the full reflectance integral (mean relative luminance error, the largest point in brackets), against what a shaded pixel costs: ns per pixel of a sphere in the default view, direct lights included (a frame with the spheres less one without, best of three).";
 
+/// The method of the ladder's rung with `fetches`: the defaults' one fetch, the ladder above.
+fn rung_method(fetches: u32) -> Method {
+    if fetches == 1 { Method::Defaults } else { Method::Ladder }
+}
+
 /// The rungs of the ladder present in `rows`, in order.
 fn rungs(rows: &[Measurement]) -> Vec<u32> {
-    let mut k: Vec<u32> = rows.iter().filter(|r| r.product == Product::ShadingCost).filter_map(|r| r.fetches).collect();
+    let mut k: Vec<u32> =
+        rows.iter().filter(|r| r.product == Product::ShadingCost).filter_map(|r| r.fetches.filter(|&k| r.method == rung_method(k))).collect();
     k.sort();
     k.dedup();
     k
 }
 
-/// The shaded colour's rows of the rung with `fetches` (the defaults at their own sample
-/// count for one fetch, the ladder above), part total.
-fn rung_rows(rows: &[Measurement], fetches: u32) -> impl Iterator<Item = &Measurement> {
+/// The cost per shaded pixel of `method` with `fetches` on the backend `engine`.
+fn cost_of(rows: &[Measurement], method: Method, fetches: u32, engine: &str) -> Option<f64> {
+    rows.iter().find(|r| r.product == Product::ShadingCost && r.method == method && r.fetches == Some(fetches) && r.backend == engine).and_then(|r| r.ns_per_pixel)
+}
+
+/// The shaded colour's rows of `method` with `fetches` at the default sample count, part
+/// total.
+fn method_rows(rows: &[Measurement], method: Method, fetches: u32) -> impl Iterator<Item = &Measurement> {
     let samples = Settings::default().samples;
     rows.iter().filter(move |r| {
         r.product == Product::ShadedColour
             && r.part == Part::Total
+            && r.method == method
             && r.fetches == Some(fetches)
+            && r.samples == Some(samples)
+            && r.knob != Knob::Quality
             && r.roughness_lo.is_none()
             && r.near_sun.is_none()
-            && match r.method {
-                Method::Defaults => fetches == 1 && r.samples == Some(samples) && r.knob == Knob::Samples,
-                Method::Ladder => true,
-                _ => false,
-            }
     })
+}
+
+/// The shaded colour's rows of the rung with `fetches`, part total.
+fn rung_rows(rows: &[Measurement], fetches: u32) -> impl Iterator<Item = &Measurement> {
+    method_rows(rows, rung_method(fetches), fetches)
 }
 
 /// The ladder's table: per rung, its cost on each backend and its error on the report's
@@ -767,22 +781,23 @@ fn ladder_table(rows: &[Measurement]) -> Option<Table> {
     if rungs.is_empty() {
         return None;
     }
-    let cost = |k: u32, engine: &str| {
-        rows.iter()
-            .find(|r| r.product == Product::ShadingCost && r.fetches == Some(k) && r.backend == engine)
-            .and_then(|r| r.ns_per_pixel)
-            .map_or("-".into(), |ns| format!("{ns:.0}"))
-    };
     let first = rows.iter().find(|r| r.product == Product::ShadedColour && r.set.is_none() && !r.backend.is_empty()).map(|r| r.backend.clone());
-    let cells = rungs
-        .iter()
-        .map(|&k| {
-            let own = |band: Option<f32>| over_environments(rung_rows(rows, k).filter(|r| r.set.is_none() && Some(&r.backend) == first.as_ref() && r.nv_hi == band));
-            let set = |s: crate::measurement::Set, band: Option<f32>| over_environments(rung_rows(rows, k).filter(|r| r.set == Some(s) && r.nv_hi == band));
+    // The rungs, then the quality mode below mip 1 (`--filtered`, one fetch but sixteen
+    // samples where it applies) for its cost beside theirs.
+    let mut lines: Vec<(String, Method, u32)> = rungs.iter().map(|&k| (format!("{k}"), rung_method(k), k)).collect();
+    if cost_of(rows, Method::FilteredSampling, 1, "gpu").or(cost_of(rows, Method::FilteredSampling, 1, "cpu")).is_some() {
+        lines.push(("1, --filtered".into(), Method::FilteredSampling, 1));
+    }
+    let cells = lines
+        .into_iter()
+        .map(|(label, method, k)| {
+            let cost = |engine: &str| cost_of(rows, method, k, engine).map_or("-".into(), |ns| format!("{ns:.0}"));
+            let own = |band: Option<f32>| over_environments(method_rows(rows, method, k).filter(|r| r.set.is_none() && Some(&r.backend) == first.as_ref() && r.nv_hi == band));
+            let set = |s: crate::measurement::Set, band: Option<f32>| over_environments(method_rows(rows, method, k).filter(|r| r.set == Some(s) && r.nv_hi == band));
             [
-                format!("{k}"),
-                cost(k, "gpu"),
-                cost(k, "cpu"),
+                label,
+                cost("gpu"),
+                cost("cpu"),
                 own(None),
                 own(Some(0.1)),
                 set(crate::measurement::Set::Tuning, None),
@@ -802,7 +817,7 @@ pub fn ladder_panels(rows: &[Measurement]) -> Vec<crate::plot::LadderPanel> {
     let rungs = rungs(rows);
     let mut panels = Vec::new();
     for engine in ["gpu", "cpu"] {
-        let ns = |k: u32| rows.iter().find(|r| r.product == Product::ShadingCost && r.fetches == Some(k) && r.backend == engine).and_then(|r| r.ns_per_pixel);
+        let ns = |k: u32| cost_of(rows, rung_method(k), k, engine);
         if rungs.iter().all(|&k| ns(k).is_none()) {
             continue;
         }

@@ -66,10 +66,14 @@ fn ladder_costs(env: &environment::Environment, backends: &[Backend], quick: boo
     for backend in backends {
         let baked = crate::bake::bake_for_display(backend, env, &crate::settings::Settings { size, ..crate::settings::Settings::default() })?;
         let device = splitsum_report::measurement::Device::of(backend);
-        for rung in 0..LADDER_RUNGS {
+        // The rungs, and the quality mode below mip 1 (`--filtered`) for its cost beside them.
+        let filtered = (Method::FilteredSampling, 1, ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::FILTERED_SAMPLING, ..ShadeOptions::DEFAULT });
+        let rungs = (0..LADDER_RUNGS).map(|rung| {
             let fetches = 1 << rung;
-            let ns = crate::render::shading_ns_per_pixel(backend, &baked, ShadeOptions::DEFAULT.with_fetches(fetches), frame, repeats)?;
-            let method = if fetches == 1 { Method::Defaults } else { Method::Ladder };
+            (if fetches == 1 { Method::Defaults } else { Method::Ladder }, fetches, ShadeOptions::DEFAULT.with_fetches(fetches))
+        });
+        for (method, fetches, options) in rungs.chain([filtered]) {
+            let ns = crate::render::shading_ns_per_pixel(backend, &baked, options, frame, repeats)?;
             rows.push(Measurement {
                 knob: Knob::Fetches,
                 fetches: Some(fetches),
