@@ -158,13 +158,16 @@ pub struct ShadingChoices {
     pub fetches: u32,
 }
 
-/// The rungs of the shading ladder a user may ask for.
-pub const FETCH_COUNTS: [u32; 5] = [1, 2, 4, 8, 16];
-
-/// `fetches` if it is a rung of the ladder, else what is wrong with it (for `--fetches`
+/// `fetches` if it is a rung of the ladder (a power of two up to `shade::MAX_FETCHES`, as
+/// `ShadeOptions::with_fetches` encodes them), else what is wrong with it (for `--fetches`
 /// and the scene field `fetches`).
 pub fn check_fetches(fetches: u32) -> std::result::Result<u32, String> {
-    if FETCH_COUNTS.contains(&fetches) { Ok(fetches) } else { Err(format!("must be one of 1, 2, 4, 8 or 16 (the shading ladder's rungs), not {fetches}")) }
+    if fetches.is_power_of_two() && fetches <= splitsum_shaders::shade::MAX_FETCHES {
+        return Ok(fetches);
+    }
+    let rungs: Vec<String> = (0..splitsum_shaders::shade::LADDER_RUNGS).map(|k| (1u32 << k).to_string()).collect();
+    let (last, rest) = rungs.split_last().expect("the ladder has rungs");
+    Err(format!("must be one of {} or {last} (the shading ladder's rungs), not {fetches}", rest.join(", ")))
 }
 
 #[cfg(feature = "cli")]

@@ -735,7 +735,7 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
 const LADDER_NOTE: &str = "The shading ladder: the split sum's one prefiltered fetch, then 2 to 16 fetches of filtered importance sampling of the true GGX lobe over the prefiltered mips (shade::lobe_radiance), used below n·v 0.7. Shaded colour against the full reflectance integral (mean relative luminance error, the largest point in brackets), against what a shaded pixel costs: ns per pixel of a sphere in the default view, direct lights included (a frame with the spheres less one without, best of three).";
 
 /// The method of the ladder's rung with `fetches`: the defaults' one fetch, the ladder above.
-fn rung_method(fetches: u32) -> Method {
+pub fn rung_method(fetches: u32) -> Method {
     if fetches == 1 { Method::Defaults } else { Method::Ladder }
 }
 

@@ -70,7 +70,7 @@ fn ladder_costs(env: &environment::Environment, backends: &[Backend], quick: boo
         let filtered = (Method::FilteredSampling, 1, ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::FILTERED_SAMPLING, ..ShadeOptions::DEFAULT });
         let rungs = (0..LADDER_RUNGS).map(|rung| {
             let fetches = 1 << rung;
-            (if fetches == 1 { Method::Defaults } else { Method::Ladder }, fetches, ShadeOptions::DEFAULT.with_fetches(fetches))
+            (crate::report::rung_method(fetches), fetches, ShadeOptions::DEFAULT.with_fetches(fetches))
         });
         for (method, fetches, options) in rungs.chain([filtered]) {
             let ns = crate::render::shading_ns_per_pixel(backend, &baked, options, frame, repeats)?;
