@@ -117,6 +117,9 @@ pub struct MaterialSpec {
     /// Blend between mips linearly instead of in log luminance (see [`ShadingChoices`]).
     #[serde(default)]
     pub linear_mip_blend: bool,
+    /// Read without lifting the read direction above the horizon (see [`ShadingChoices`]).
+    #[serde(default)]
+    pub no_horizon_lift: bool,
     /// Prefiltered fetches per pixel of the shading ladder: 1, 2, 4, 8 or 16 (see
     /// [`ShadingChoices`]).
     #[serde(default = "one")]
@@ -124,7 +127,7 @@ pub struct MaterialSpec {
 }
 
 /// The shading options a user chooses beside the models, with their defaults: the
-/// prefiltered cube read along the dominant direction and blended between mips in log
+/// prefiltered cube read along the dominant direction, lifted above the horizon, blended between mips in log
 /// luminance, single scattering, no filtered sampling, the exact Smith term for direct
 /// lights. The one place their flags are made,
 /// and (with the `cli` feature) the command line's flags themselves; a scene file spells
@@ -151,6 +154,11 @@ pub struct ShadingChoices {
     /// in log luminance.
     #[cfg_attr(feature = "cli", arg(long))]
     pub linear_mip_blend: bool,
+    /// Read the prefiltered cube along the read direction as it is, even where the lobe
+    /// round it reaches under the surface's horizon, instead of lifting it above
+    /// (`shade::above_horizon`).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub no_horizon_lift: bool,
     /// Prefiltered fetches per pixel: 1 is the split sum; 2, 4, 8 or 16 follow the true
     /// specular lobe at grazing views (the shading ladder, `shade::lobe_radiance`), at that
     /// many fetches' cost. `runner report` measures each rung's error against its cost.
@@ -191,6 +199,7 @@ impl ShadingChoices {
         set(self.filtered, ShadeOptions::FILTERED_SAMPLING);
         set(!self.smith_schlick, ShadeOptions::CORRELATED_SMITH);
         set(!self.linear_mip_blend, ShadeOptions::LOG_MIP_BLEND);
+        set(!self.no_horizon_lift, ShadeOptions::LIFT_ABOVE_HORIZON);
         ShadeOptions { flags: f, ..ShadeOptions::DEFAULT }.with_fetches(self.fetches).flags
     }
 }
@@ -224,6 +233,7 @@ impl MaterialSpec {
                 filtered: self.filtered,
                 smith_schlick: self.smith_schlick,
                 linear_mip_blend: self.linear_mip_blend,
+                no_horizon_lift: self.no_horizon_lift,
                 fetches: self.fetches,
             }
             .flags(self.ibl, true),

@@ -127,6 +127,7 @@ impl Sweep {
             Method { kind: Kind::FilteredSampling, settings: default.clone(), flags: flags | ShadeOptions::FILTERED_SAMPLING },
             Method { kind: Kind::LinearMipBlend, settings: default.clone(), flags: flags & !ShadeOptions::LOG_MIP_BLEND },
             Method { kind: Kind::TableF0, settings: default.clone(), flags: flags | ShadeOptions::TABLE_F0 },
+            Method { kind: Kind::NoHorizonLift, settings: default.clone(), flags: flags & !ShadeOptions::LIFT_ABOVE_HORIZON },
         ]);
         // The shading ladder: the defaults' bake read with 2, 4, 8 and 16 fetches.
         let base = ShadeOptions { flags, ..ShadeOptions::DEFAULT };
@@ -139,7 +140,7 @@ impl Sweep {
         for (kind, target) in [(Kind::KhronosBevyLookup, Target::Khronos), (Kind::FilamentLookup, Target::Filament)] {
             let fixed = target.fixed();
             let settings = Settings { mapping: fixed.mapping, mips: fixed.mips.map(|m| m(src)), ..default.clone() };
-            methods.push(Method { kind, settings, flags: flags & !ShadeOptions::LOG_MIP_BLEND });
+            methods.push(Method { kind, settings, flags: flags & !(ShadeOptions::LOG_MIP_BLEND | ShadeOptions::LIFT_ABOVE_HORIZON) });
         }
         methods
     }

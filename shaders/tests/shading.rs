@@ -68,6 +68,35 @@ fn dominant_direction_limits() {
     }
 }
 
+/// The lift above the horizon against its closed form in f64 trigonometry: a read direction
+/// lower than `θ = 2·atan(HORIZON_LIFT·α)` above the horizon comes back at exactly that
+/// elevation, at the same azimuth; one higher comes back unchanged; the result is a unit
+/// vector. Tolerance 2e-6: f32 rounding of unit vectors.
+#[test]
+fn the_read_is_lifted_to_the_lobes_half_angle_above_the_horizon() {
+    let n = Vec3::new(0.36, -0.48, 0.8);
+    let (t, b) = splitsum_shaders::sampling::orthonormal_basis(n);
+    for &r in &[0.05f32, 0.2, 0.5, 0.8, 1.0] {
+        let alpha = (r as f64) * (r as f64);
+        let theta = 2.0 * (shade::HORIZON_LIFT as f64 * alpha).atan();
+        for &elevation in &[0.0f64, 0.05, 0.2, 0.5, 1.0, 1.5] {
+            let azimuth = 0.7f64;
+            let d = (t * azimuth.cos() as f32 + b * azimuth.sin() as f32) * elevation.cos() as f32 + n * elevation.sin() as f32;
+            let got = shade::above_horizon(n, d, r);
+            assert!((got.length() - 1.0).abs() < 2e-6, "r {r}, elevation {elevation}: {got:?}");
+            let want = elevation.max(theta.min(std::f64::consts::FRAC_PI_2));
+            assert!((got.dot(n) as f64 - want.sin()).abs() < 2e-6, "r {r}, elevation {elevation}: sin {} for {}", got.dot(n), want.sin());
+            if elevation >= theta {
+                assert!((got - d).length() < 2e-6, "r {r}: a direction above was moved");
+            } else if want < std::f64::consts::FRAC_PI_2 - 1e-3 {
+                let flat = got - n * got.dot(n);
+                let got_azimuth = (flat.dot(b) as f64).atan2(flat.dot(t) as f64);
+                assert!((got_azimuth - azimuth).abs() < 1e-5, "r {r}: azimuth {got_azimuth}");
+            }
+        }
+    }
+}
+
 /// Filtered sampling at shading time of a constant sky returns the constant (its weights
 /// sum to one), for every roughness below mip 1.
 #[test]

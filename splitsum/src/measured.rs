@@ -60,6 +60,8 @@ pub enum Method {
     SmithSchlickTable,
     /// The defaults, blending between mips linearly (before the log-luminance blend).
     LinearMipBlend,
+    /// The defaults, reading without lifting the read direction above the horizon.
+    NoHorizonLift,
     /// The defaults reading the table as `F₀·A + B` (`ShadeOptions::TABLE_F0`).
     TableF0,
     /// The defaults with the shading ladder's `fetches` prefiltered fetches per pixel.
@@ -87,6 +89,7 @@ impl Method {
             Method::FilteredSampling => "defaults + filtered sampling",
             Method::SmithSchlickTable => "defaults, Smith-Schlick table",
             Method::LinearMipBlend => "defaults, linear mip blend",
+            Method::NoHorizonLift => "defaults, read not lifted above the horizon",
             Method::TableF0 => "defaults, table read as F0*A + B",
             Method::Ladder => "shading ladder",
             Method::KhronosBevyLookup => "khronos/bevy target, engine's trilinear read",
