@@ -80,17 +80,19 @@ fn gpu_matches_the_cpu_reference() {
     assert!(worst_all < bound, "{worst_all:e} (bound {bound:e})");
 }
 
-/// Every shading option of the image-based and direct light (dominant direction, multiple
+/// Every shading option of the image-based and direct light (dominant direction, the lift
+/// above the horizon, multiple
 /// scattering, exact Smith for direct light, filtered sampling below mip 1, the table read
 /// as `F₀·A + B`, the shading ladder's 2 to 16 fetches), alone and all together, GPU
 /// against CPU, under the same bound as the models.
 #[test]
 fn shading_options_gpu_match_the_cpu_reference() {
     let base = ShadeOptions::IBL | ShadeOptions::DIRECT;
-    let all = ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::MULTISCATTER | ShadeOptions::CORRELATED_SMITH | ShadeOptions::FILTERED_SAMPLING;
+    let all = ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::LIFT_ABOVE_HORIZON | ShadeOptions::MULTISCATTER | ShadeOptions::CORRELATED_SMITH | ShadeOptions::FILTERED_SAMPLING;
     let extras = [
         0,
         ShadeOptions::DOMINANT_DIRECTION,
+        ShadeOptions::LIFT_ABOVE_HORIZON,
         ShadeOptions::MULTISCATTER,
         ShadeOptions::CORRELATED_SMITH,
         ShadeOptions::FILTERED_SAMPLING,

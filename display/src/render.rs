@@ -103,6 +103,7 @@ impl ViewState {
         fn ibl_options(flags: u32) -> String {
             let names: Vec<String> = [
                 (ShadeOptions::DOMINANT_DIRECTION, "dominant direction"),
+                (ShadeOptions::LIFT_ABOVE_HORIZON, "lifted above the horizon"),
                 (ShadeOptions::MULTISCATTER, "multiple scattering"),
                 (ShadeOptions::FILTERED_SAMPLING, "filtered"),
                 (ShadeOptions::CORRELATED_SMITH, "exact Smith for lights"),

@@ -86,10 +86,19 @@ struct ShadingPoint {
     full_schlick: [f64; 3],
     /// Exact `E/π` along `n`.
     irradiance: [f64; 3],
-    /// Exact prefiltered radiance along the mirror direction and the dominant direction.
-    prefiltered: [[f64; 3]; 2],
+    /// Exact prefiltered radiance along each direction the one fetch may read along
+    /// (`shade::read_direction`), indexed by [`read_index`].
+    prefiltered: [[f64; 3]; 4],
     /// Exact tables `(A, B)`: Smith–Schlick, exact Smith.
     table: [Vec2; 2],
+}
+
+/// The read-direction flags of [`ShadingPoint::prefiltered`]'s entries.
+const READ_FLAGS: [u32; 4] = [0, ShadeOptions::DOMINANT_DIRECTION, ShadeOptions::LIFT_ABOVE_HORIZON, ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::LIFT_ABOVE_HORIZON];
+
+/// The entry of [`ShadingPoint::prefiltered`] that shading with `flags` reads along.
+fn read_index(flags: u32) -> usize {
+    usize::from(flags & ShadeOptions::DOMINANT_DIRECTION != 0) + 2 * usize::from(flags & ShadeOptions::LIFT_ABOVE_HORIZON != 0)
 }
 
 /// One lookup of the prefiltered radiance.
@@ -179,8 +188,6 @@ impl Points {
             .map(|(m, n, v)| {
                 let (na, va, b) = (arr(n), arr(v), arr(m.base_color));
                 let r = m.roughness as f64;
-                let refl = sampling::reflect(v, n);
-                let dominant = shade::dominant_direction(n, refl, m.roughness);
                 let nv = n.dot(v).max(shade::MIN_N_DOT_V) as f64;
                 let table = |smith| {
                     let (a, b) = reference::brdf_lut_with(nv, r, 1e-7, smith);
@@ -193,7 +200,19 @@ impl Points {
                     truth: env.shade(na, va, b, m.metallic as f64, r, reference::Smith::Correlated),
                     full_schlick: env.shade(na, va, b, m.metallic as f64, r, reference::Smith::Schlick),
                     irradiance: env.integrate(|l| [reference::dot(na, l).max(0.0) / std::f64::consts::PI; 3], |_| f64::INFINITY).0,
-                    prefiltered: [env.prefilter(arr(refl), r), env.prefilter(arr(dominant), r)],
+                    prefiltered: {
+                        // The four read directions, each summed once (most coincide away
+                        // from grazing views).
+                        let dirs: [Vec3; 4] = std::array::from_fn(|k| shade::read_direction(READ_FLAGS[k], n, v, m.roughness));
+                        let mut sums: [[f64; 3]; 4] = [[0.0; 3]; 4];
+                        for k in 0..4 {
+                            sums[k] = match (0..k).find(|&j| dirs[j] == dirs[k]) {
+                                Some(j) => sums[j],
+                                None => env.prefilter(arr(dirs[k]), r),
+                            };
+                        }
+                        sums
+                    },
                     table: [table(reference::Smith::Schlick), table(reference::Smith::Correlated)],
                 }
             })
@@ -266,7 +285,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
         let ms = *ms;
         let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
         let opts = method.options();
-        let dominant = usize::from(opts.flags & ShadeOptions::DOMINANT_DIRECTION != 0);
+        let read = read_index(opts.flags);
         let correlated = usize::from(method.settings.lut_masking.unwrap_or(method.settings.lut_method.default_masking()) == Masking::SmithCorrelated);
         let per_point: Vec<PointErrors> = points
             .shading
@@ -275,7 +294,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
                 let m = &p.material;
                 let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, opts, m, p.n, p.v);
                 let shown = shade::ibl(opts, m, p.n, p.v, s);
-                let exact = IblSample { prefiltered: vec(p.prefiltered[dominant]), irradiance: vec(p.irradiance), brdf: p.table[correlated] };
+                let exact = IblSample { prefiltered: vec(p.prefiltered[read]), irradiance: vec(p.irradiance), brdf: p.table[correlated] };
                 let split = shade::ibl(opts, m, p.n, p.v, exact);
                 let full = if correlated == 1 { p.truth } else { p.full_schlick };
                 PointErrors {
