@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# splitsum against Mitsuba 3 (scalar_rgb, from PyPI, in a virtual environment under
+# target/): single white-metal spheres (r 0.5, 0.65, 0.8) under every sunny environment of
+# the tuning and the held-out sets, rendered by Mitsuba's path tracer (one bounce: the
+# exact reflectance integral, estimated), and splitsum's shading of the same pixels at 1, 4
+# and 16 fetches. Prints the table the README quotes. About 15 minutes on 2 cores.
+#   bash scripts/mitsuba.sh [SPP] [RES]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+SPP=${1:-256}
+RES=${2:-64}
+bash scripts/dev.sh environments >&2
+VENV=target/mitsuba-venv
+if [ ! -x "$VENV/bin/python" ]; then
+    python3 -m venv "$VENV"
+    "$VENV/bin/pip" install -q "mitsuba==3.9.1" "numpy>=1.26" >&2
+fi
+OUT=target/mitsuba
+rm -rf "$OUT" && mkdir -p "$OUT"
+export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
+bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- envs "$OUT"
+"$VENV/bin/python" scripts/mitsuba_spheres.py render "$OUT" "$SPP" "$RES" >&2
+bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- shade "$OUT"
+"$VENV/bin/python" scripts/mitsuba_spheres.py compare "$OUT"

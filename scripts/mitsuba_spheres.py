@@ -1,0 +1,146 @@
+"""Mitsuba 3 renders of single white-metal spheres (F0 = 1: Mitsuba's roughconductor
+with material 'none', GGX, visible-normal sampling) under each sunny environment that
+`mitsuba_spheres envs DIR` wrote, and their comparison with splitsum's shading of the same
+pixels (`mitsuba_spheres shade DIR`). Run by scripts/mitsuba.sh.
+
+  python3 mitsuba_spheres.py render DIR SPP RES
+  python3 mitsuba_spheres.py compare DIR
+"""
+import math
+import struct
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROUGHNESS = [0.5, 0.65, 0.8]
+FETCHES = [1, 4, 16]
+# The pixels compared: the sphere's interior, n.v >= 0.15 (at the rim a pixel's footprint
+# spans normals its averaged normal does not stand for).
+MIN_NV = 0.15
+
+
+def splitsum_dir(u, v):
+    """splitsum's equirect direction at (u, v) (shaders/src/equirect.rs, uv_to_dir)."""
+    phi = 2 * math.pi * (u - 0.5)
+    theta = math.pi * v
+    return np.array([math.sin(theta) * math.sin(phi), math.cos(theta), -math.sin(theta) * math.cos(phi)])
+
+
+def environment_transform(mi, exr):
+    """The rotation about +y (and mirror) that makes Mitsuba's envmap give, for a direction,
+    the radiance splitsum reads there: found on six texels, not assumed. (Mitsuba's
+    bilinear read sits a fraction of a texel from splitsum's texel centres, hence the 10 %
+    tolerance; a wrong orientation is off by tens of percent, and must be at least three
+    times further off than the right one.)"""
+    bitmap = np.array(mi.Bitmap(str(exr)).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32, srgb_gamma=False))
+    h, w, _ = bitmap.shape
+    lum = bitmap @ np.array([0.2126, 0.7152, 0.0722])
+    # The brightest texel tells rotations apart where the sky alone is the same at every
+    # azimuth (the generated skies).
+    picks = [np.unravel_index(np.argmax(lum), lum.shape), (h // 3, w // 5), (h // 2 + 7, 3 * w // 4), (h // 5, w // 2 + 11), (2 * h // 3, w // 7), (h // 4, 5 * w // 8)]
+    scores = []
+    best = None
+    for angle in [0, 90, 180, 270]:
+        for flip in [1, -1]:
+            to_world = mi.ScalarTransform4f().rotate([0, 1, 0], angle) @ mi.ScalarTransform4f().scale([flip, 1, 1])
+            emitter = mi.load_dict({"type": "envmap", "filename": str(exr), "to_world": to_world})
+            err = 0.0
+            for (y, x) in picks:
+                d = splitsum_dir((x + 0.5) / w, (y + 0.5) / h)
+                si = mi.SurfaceInteraction3f()
+                si.wi = mi.Vector3f(-d)
+                got = np.array(emitter.eval(si))
+                want = bitmap[y, x]
+                err += float(np.abs(got - want).sum() / (np.abs(want).sum() + 1e-9)) / len(picks)
+            scores.append(err)
+            if best is None or err < best[0]:
+                best = (err, to_world, angle, flip)
+    runner_up = sorted(scores)[1]
+    if best[0] > 0.1 or runner_up < 3 * best[0]:
+        raise SystemExit(f"{exr}: no one rotation of Mitsuba's envmap matches splitsum's directions (best {best[0]:.3g}, next {runner_up:.3g})")
+    return best[1], best[2], best[3]
+
+
+def render(directory, spp, res):
+    import mitsuba as mi
+    mi.set_variant("scalar_rgb")
+    directory = Path(directory)
+    for line in (directory / "envs.txt").read_text().splitlines():
+        slug = line.split("\t")[0]
+        exr = directory / f"{slug}.exr"
+        to_world, angle, flip = environment_transform(mi, exr)
+        sensor = {
+            "type": "orthographic",
+            "to_world": mi.ScalarTransform4f().look_at(origin=[0, 0, 4], target=[0, 0, 0], up=[0, 1, 0]) @ mi.ScalarTransform4f().scale([1.05, 1.05, 1]),
+            "film": {"type": "hdrfilm", "width": res, "height": res, "rfilter": {"type": "box"}, "pixel_format": "rgb"},
+            "sampler": {"type": "independent", "sample_count": spp},
+        }
+        emitter = {"type": "envmap", "filename": str(exr), "to_world": to_world}
+        normals = mi.render(mi.load_dict({"type": "scene", "integrator": {"type": "aov", "aovs": "nn:sh_normal"}, "sensor": dict(sensor, sampler={"type": "independent", "sample_count": 16}), "sphere": {"type": "sphere"}}))
+        normals = np.array(normals)[:, :, :3].reshape(-1, 3)
+        length = np.linalg.norm(normals, axis=1)
+        view = np.array([0.0, 0.0, 1.0])
+        inside = (length > 0.999) & (normals @ view / np.maximum(length, 1e-9) >= MIN_NV)
+        n = normals[inside] / length[inside, None]
+        v = np.broadcast_to(view, n.shape)
+        np.concatenate([n, v], axis=1).astype("<f4").tofile(directory / f"{slug}_points.f32")
+        for r in ROUGHNESS:
+            scene = mi.load_dict({
+                "type": "scene",
+                # Depth 2: the environment seen in the sphere once (a convex sphere sees
+                # nothing else), the exact reflectance integral, estimated.
+                "integrator": {"type": "path", "max_depth": 2},
+                "sensor": sensor,
+                "emitter": emitter,
+                "sphere": {"type": "sphere", "bsdf": {"type": "roughconductor", "material": "none", "distribution": "ggx", "alpha": r * r, "sample_visible": True}},
+            })
+            # Two independent halves of the samples: their mean is the estimate, their
+            # difference measures its noise (the floor under any per-pixel comparison).
+            halves = [np.array(mi.render(scene, seed=seed, spp=max(spp // 2, 1)))[:, :, :3].reshape(-1, 3)[inside] for seed in (7, 8)]
+            np.stack(halves).astype("<f4").tofile(directory / f"{slug}_r{r}_mitsuba.f32")
+        print(f"rendered {slug} (envmap rotated {angle} degrees about +y, x scaled {flip}), {inside.sum()} pixels", flush=True)
+
+
+def luminance(rgb):
+    return rgb @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def compare(directory):
+    directory = Path(directory)
+    rows = []
+    print("| environment | set | r | Mitsuba's noise per pixel | " + " | ".join(f"{k} fetch{'es' if k > 1 else ''}: mean per pixel (sphere's mean)" for k in FETCHES) + " | n.v 0.15-0.7, 1 fetch (signed) |")
+    print("|---|---|---|---|" + "---|" * (len(FETCHES) + 1))
+    for line in (directory / "envs.txt").read_text().splitlines():
+        slug, which, name = line.split("\t")
+        points = np.fromfile(directory / f"{slug}_points.f32", dtype="<f4").reshape(-1, 6)
+        nv = points[:, 2]
+        for r in ROUGHNESS:
+            halves = luminance(np.fromfile(directory / f"{slug}_r{r}_mitsuba.f32", dtype="<f4").reshape(2, -1, 3))
+            truth = halves.mean(axis=0)
+            # The standard error of the two halves' mean, per pixel, relative.
+            noise = np.abs(halves[0] - halves[1]) / 2 / np.maximum(truth, 1e-6)
+            cells = [f"{100 * noise.mean():.1f} %"]
+            signed = None
+            for k in FETCHES:
+                got = luminance(np.fromfile(directory / f"{slug}_r{r}_k{k}.f32", dtype="<f4").reshape(-1, 3))
+                rel = np.abs(got - truth) / np.maximum(truth, 1e-6)
+                whole = abs(got.mean() - truth.mean()) / truth.mean()
+                cells.append(f"{100 * rel.mean():.1f} % ({100 * whole:.1f} %)")
+                rows.append((which, r, k, rel.mean(), whole, noise.mean()))
+                if k == 1:
+                    band = nv <= 0.7
+                    signed = (got[band] - truth[band]).mean() / truth[band].mean()
+            print(f"| {name} | {which} | {r} | " + " | ".join(cells) + f" | {100 * signed:+.1f} % |")
+    print()
+    for which in ["tuning", "held-out"]:
+        for k in FETCHES:
+            sel = [row for row in rows if row[0] == which and row[2] == k]
+            print(f"{which}, {k} fetch(es): mean over spheres of the mean per-pixel error {100 * np.mean([s[3] for s in sel]):.1f} % (Mitsuba's noise {100 * np.mean([s[5] for s in sel]):.1f} %), worst sphere {100 * max(s[3] for s in sel):.1f} %; error of the sphere's mean {100 * np.mean([s[4] for s in sel]):.1f} %")
+
+
+if __name__ == "__main__":
+    if sys.argv[1] == "render":
+        render(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
+    else:
+        compare(sys.argv[2])
