@@ -96,9 +96,11 @@ struct ShadingPoint {
 /// The read-direction flags of [`ShadingPoint::prefiltered`]'s entries.
 const READ_FLAGS: [u32; 4] = [0, ShadeOptions::DOMINANT_DIRECTION, ShadeOptions::LIFT_ABOVE_HORIZON, ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::LIFT_ABOVE_HORIZON];
 
-/// The entry of [`ShadingPoint::prefiltered`] that shading with `flags` reads along.
+/// The entry of [`ShadingPoint::prefiltered`] that shading with `flags` reads along: the
+/// one whose read-direction flags are those of `flags`.
 fn read_index(flags: u32) -> usize {
-    usize::from(flags & ShadeOptions::DOMINANT_DIRECTION != 0) + 2 * usize::from(flags & ShadeOptions::LIFT_ABOVE_HORIZON != 0)
+    let read = flags & (ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::LIFT_ABOVE_HORIZON);
+    READ_FLAGS.iter().position(|&f| f == read).expect("READ_FLAGS lists every combination of the read-direction flags")
 }
 
 /// One lookup of the prefiltered radiance.
