@@ -169,12 +169,19 @@ case "$cmd" in
         done
         exec cargo +stable package --workspace --exclude splitsum-tests --exclude runner "$@"
         ;;
+    table)
+        # The BRDF table the library embeds (splitsum/src/table.rs), computed afresh.
+        ensure_stable
+        f=splitsum/assets/brdf_table_256_quadrature_correlated.f32
+        [ -f "$f" ] || : > "$f"
+        exec cargo +stable run --release -q -p splitsum --features internals --example embedded_table -- "$f"
+        ;;
     spirv)
         ensure_nightly
         exec cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
         ;;
     *)
-        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | peers | environments" >&2
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | table | peers | environments" >&2
         exit 2
         ;;
 esac

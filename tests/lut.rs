@@ -195,3 +195,20 @@ fn quadrature_table_every_texel_of_256() {
         assert!(worst <= 1e-5);
     }
 }
+
+/// The table the library embeds (`splitsum::table`, the defaults' table, which every bake
+/// at the defaults uploads instead of integrating) is a fresh CPU computation bit for bit,
+/// and it is the table the default settings resolve to. Its accuracy against the f64
+/// reference is the quadrature tests' above (same function).
+#[test]
+fn embedded_table_is_a_fresh_computation_bit_for_bit() {
+    use splitsum::table::{self, TableKey};
+    let fresh = table::compute(TableKey::EMBEDDED).expect("fresh table");
+    let embedded = table::embedded();
+    assert_eq!(embedded.len(), fresh.len(), "embedded table has {} texels, a fresh one {}", embedded.len(), fresh.len());
+    let differ = embedded.iter().zip(&fresh).filter(|(e, f)| e.x.to_bits() != f.x.to_bits() || e.y.to_bits() != f.y.to_bits()).count();
+    assert_eq!(differ, 0, "{differ} texels of the embedded table differ from a fresh computation: run `bash scripts/dev.sh table`");
+    let job = splitsum::Settings::default().resolve(splitsum::InputShape::Unknown, splitsum::Products::ALL).expect("defaults");
+    assert_eq!(TableKey::of(&job), TableKey::EMBEDDED, "the defaults no longer read the embedded table");
+    assert!(std::sync::Arc::ptr_eq(&table::texels(TableKey::EMBEDDED).unwrap(), &table::texels(TableKey::EMBEDDED).unwrap()), "the table is decoded once per process");
+}

@@ -8,7 +8,7 @@ use crate::backend::{Backend, Kernels, Prefilter, with_kernels};
 use crate::cost::{self, Calibration};
 use crate::environment::Environment;
 use crate::error::{Error, Result};
-use crate::settings::{InputShape, Job, Products, Settings, Step, TableMethod};
+use crate::settings::{InputShape, Job, Products, Settings, Step};
 use crate::texture::{Cube, Lut, Sh9};
 use serde::Serialize;
 use splitsum_shaders::cubemap::{self, CubeLayout};
@@ -143,10 +143,8 @@ pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout,
     };
     let sh9 = if p.sh9 { Some(timed(k, &mut timings, Step::Sh9, estimates, || k.sh9(&source, source_layout, job.sh_level()))?) } else { None };
     let lut = if p.lut {
-        Some(timed(k, &mut timings, Step::BrdfTable, estimates, || match job.lut_method {
-            TableMethod::Quadrature => k.brdf_table(job.lut_size, job.lut_masking),
-            TableMethod::Sampled => k.brdf_lut(job.lut_size, job.lut_samples),
-        })?)
+        // A constant (`crate::table`): embedded or computed once per process, then uploaded.
+        Some(timed(k, &mut timings, Step::BrdfTable, estimates, || k.upload("brdf table", &crate::table::texels(crate::table::TableKey::of(job))?))?)
     } else {
         None
     };

@@ -80,6 +80,7 @@ internal_modules! {
     measured;
     preview;
     progress;
+    table;
 }
 
 pub use adjustment::Adjustment;
