@@ -249,3 +249,31 @@ fn a_target_refuses_flags_its_engine_cannot_read() {
     assert!(e.contains("khronos") && e.contains("filament"), "{e}");
     assert!(!out.exists());
 }
+
+/// `runner bake A B … --out DIR` bakes each environment into `DIR/NAME` on one device; one
+/// that fails is named and the others are still written; two that would share a folder are
+/// refused before anything is read or written.
+#[test]
+fn a_batch_writes_each_environment_and_survives_a_bad_one() {
+    let d = scratch("batch");
+    let out = d.join("out");
+    let o = out.to_str().unwrap();
+    let (a, b) = (repo("splitsum/assets/courtyard.exr"), repo("assets/environments/studio.exr"));
+    let bad = d.join("broken.hdr");
+    std::fs::write(&bad, b"#?RADIANCE\nnot an image\n").unwrap();
+    let e = err(&["bake", &a, bad.to_str().unwrap(), &b, "--backend", "cpu", "--size", "16", "--out", o]);
+    assert!(e.contains("1 of 3") && e.contains("broken.hdr"), "{e}");
+    assert_eq!(names(&out), ["courtyard", "studio"]);
+    for (name, src) in [("courtyard", &a), ("studio", &b)] {
+        let json = std::fs::read_to_string(out.join(name).join("bake.json")).unwrap();
+        assert!(json.contains(src.as_str()), "{name}/bake.json names its environment: {json}");
+        assert!(out.join(name).join("specular.ktx2").exists());
+    }
+    let twin = d.join("twin");
+    std::fs::create_dir_all(&twin).unwrap();
+    std::fs::copy(&a, twin.join("courtyard.exr")).unwrap();
+    let o2 = d.join("out2");
+    let e = err(&["bake", &a, twin.join("courtyard.exr").to_str().unwrap(), "--backend", "cpu", "--out", o2.to_str().unwrap()]);
+    assert!(e.contains("ENV") && e.contains("both"), "{e}");
+    assert!(!o2.exists(), "nothing is written when two outputs collide");
+}

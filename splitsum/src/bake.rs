@@ -257,3 +257,59 @@ pub fn host_source_cube(backend: &Backend, env: &Environment, settings: &Setting
         Ok(Cube { layout, texels: k.read(&t)? })
     })
 }
+
+/// One environment of a batch ([`bake_batch`]), read and baked.
+pub struct Batched {
+    /// What was found and changed while reading it.
+    pub input: crate::environment::InputReport,
+    /// The bake resolved for it.
+    pub job: Job,
+    /// What reading and baking changed from what was given (to state and record).
+    pub adjustments: Vec<crate::Adjustment>,
+    /// Its products, in host memory.
+    pub baked: Baked,
+}
+
+/// Bakes `products` of every environment in `paths` with `settings` on `backend`: one
+/// device and one set of pipelines for all, the next input read (on a thread of its own)
+/// while the current one bakes, and each bake handed to `deliver` on a third thread (so
+/// writing it overlaps the next bake). An input that fails to read or bake is handed over as
+/// its error and the others go on. Returns what `deliver` returned, in the order of `paths`.
+/// The settings are checked once, before anything is read.
+pub fn bake_batch<R: Send>(
+    backend: &Backend,
+    paths: &[std::path::PathBuf],
+    settings: &Settings,
+    products: Products,
+    sanitize: bool,
+    deliver: impl Fn(&std::path::Path, Result<Batched>) -> R + Sync,
+) -> Result<Vec<R>> {
+    use std::sync::mpsc::sync_channel;
+    let face = settings.resolve(InputShape::Unknown, products)?.source_size;
+    let (read_tx, read_rx) = sync_channel(1);
+    let (baked_tx, baked_rx) = sync_channel::<(usize, Result<Batched>)>(1);
+    std::thread::scope(|s| {
+        s.spawn(move || {
+            for (i, p) in paths.iter().enumerate() {
+                if read_tx.send((i, crate::environment::load_for(p, sanitize, face))).is_err() {
+                    break;
+                }
+            }
+        });
+        let deliver = &deliver;
+        let writer = s.spawn(move || baked_rx.into_iter().map(|(i, b)| deliver(&paths[i], b)).collect::<Vec<R>>());
+        for (i, read) in read_rx {
+            let batched = read.and_then(|(env, input)| {
+                let job = settings.resolve(InputShape::of(&env), products)?;
+                let baked = bake_job(backend, &env, &job)?;
+                let adjustments = input.adjustments(&env).into_iter().chain(job.adjustments()).collect();
+                Ok(Batched { input, job, adjustments, baked })
+            });
+            if baked_tx.send((i, batched)).is_err() {
+                break;
+            }
+        }
+        drop(baked_tx);
+        Ok(writer.join().expect("the batch's writer thread panicked"))
+    })
+}

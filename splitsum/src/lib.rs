@@ -85,7 +85,7 @@ internal_modules! {
 
 pub use adjustment::Adjustment;
 pub use crate::backend::{Backend, BackendKind, Gpu};
-pub use crate::bake::{Baked, Timing, bake, bake_job};
+pub use crate::bake::{Baked, Batched, Timing, bake, bake_batch, bake_job};
 pub use environment::{Environment, InputReport, InputShape};
 pub use error::{Error, Result};
 pub use field::{Field, Step};

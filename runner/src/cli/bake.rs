@@ -7,12 +7,15 @@ use crate::{bake, output};
 #[derive(Args)]
 pub(super) struct BakeArgs {
     /// The environment: an equirectangular .hdr or .exr, or a folder holding six faces
-    /// px nx py ny pz nz (.hdr or .exr) in Vulkan/KTX2 orientation (or --scene).
+    /// px nx py ny pz nz (.hdr or .exr) in Vulkan/KTX2 orientation (or --scene). Several
+    /// are baked as a batch on one device, each into --out/NAME (its file name without
+    /// the extension).
     #[arg(required_unless_present = "scene")]
-    env: Option<PathBuf>,
+    env: Vec<PathBuf>,
     #[command(flatten)]
     scene: SceneArgs,
-    /// Output folder (created if missing).
+    /// Output folder (created if missing); for a batch, the folder that holds one per
+    /// environment.
     #[arg(long, default_value = "out")]
     out: PathBuf,
     #[command(flatten)]
@@ -28,7 +31,7 @@ pub(super) struct BakeArgs {
 
 pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
     if let Some(scene_path) = &args.scene.scene {
-        if args.env.is_some() {
+        if !args.env.is_empty() {
             return Err(Usage::new("give either ENV or --scene, not both (the scene names its environment)").into());
         }
         refuse_beside_scene(given, &SCENE_FLAGS)?;
@@ -39,7 +42,10 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
         out.commit()?;
         return Ok(());
     }
-    let env_path = args.env.clone().expect("clap requires ENV without --scene");
+    if args.env.len() > 1 {
+        return batch_command(args, given);
+    }
+    let env_path = args.env[0].clone();
     let settings = args.quality.settings();
     // An engine target bakes only what its engine reads.
     let products = settings.target.products();
@@ -57,9 +63,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     }
     let baked = bake::bake_job(&backend, &env, &job)?;
     let about = output::About { environment: env_path.display().to_string(), backend: backend.describe(), input: Some(input) };
-    let name = out.target().file_name().map_or_else(|| "ibl".into(), |n| n.to_string_lossy().into_owned());
-    let manifest = output::write_into(out.path(), &name, &baked, &job, about)?;
-    out.commit()?;
+    let manifest = write_bake(out, &baked, &job, about)?;
     for t in &manifest.timings {
         println!("  {:<12} {:>9.3} s", t.step.name(), t.seconds);
     }
@@ -72,6 +76,64 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
         );
     }
     println!("wrote {} files to {}", manifest.files.len() + 1, args.out.display());
+    Ok(())
+}
+
+/// Writes `baked` into the output folder `out` and commits it.
+fn write_bake(out: files::OutputDir, baked: &splitsum::Baked, job: &splitsum::Job, about: output::About) -> anyhow::Result<output::Manifest> {
+    let name = out.target().file_name().map_or_else(|| "ibl".into(), |n| n.to_string_lossy().into_owned());
+    let manifest = output::write_into(out.path(), &name, baked, job, about)?;
+    out.commit()?;
+    Ok(manifest)
+}
+
+/// `runner bake A B … --out DIR`: every environment on one device with one set of
+/// pipelines (`splitsum::bake_batch`: the next input read while one bakes, the files
+/// written while the next bakes), each into `DIR/NAME`. Every output folder is checked
+/// before anything is read; an environment that fails is reported and the others go on.
+fn batch_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
+    let settings = args.quality.settings();
+    let products = settings.target.products();
+    settings.resolve(InputShape::Unknown, products)?;
+    refuse_unread(given, &settings, products, args.env.iter().all(|p| p.is_dir()))?;
+    let mut names: std::collections::BTreeMap<String, &PathBuf> = Default::default();
+    let mut outs = Vec::new();
+    for p in &args.env {
+        let name = p.file_stem().map(|n| n.to_string_lossy().into_owned()).filter(|n| !n.is_empty() && n != "." && n != "..");
+        let name = name.ok_or_else(|| Usage::new(format!("ENV {} names no file or folder to name its output after", p.display())))?;
+        if let Some(first) = names.insert(name.clone(), p) {
+            return Err(Usage::new(format!(
+                "ENV {} and {} would both be written to --out {}: give environments with different names (or bake them in two runs)",
+                first.display(),
+                p.display(),
+                args.out.join(&name).display()
+            ))
+            .into());
+        }
+        outs.push(std::sync::Mutex::new(Some(files::OutputDir::begin(&args.out.join(&name), "--out")?)));
+    }
+    let backend = Backend::open(args.backend)?;
+    println!("baking {} environments on {} for {} into {}", args.env.len(), backend.describe(), settings.target.name(), args.out.display());
+    let start = Instant::now();
+    let index = |p: &std::path::Path| args.env.iter().position(|q| q == p).expect("one of the batch");
+    let results = splitsum::bake_batch(&backend, &args.env, &settings, products, args.sanitize, |path, batched| -> anyhow::Result<()> {
+        let out = outs[index(path)].lock().unwrap_or_else(|e| e.into_inner()).take().expect("each output once");
+        let b = batched.map_err(crate::cli::bake_error)?;
+        for a in &b.adjustments {
+            eprintln!("note: {}: {}", path.display(), a.describe(&flag_of));
+        }
+        let about = output::About { environment: path.display().to_string(), backend: backend.describe(), input: Some(b.input) };
+        let manifest = write_bake(out, &b.baked, &b.job, about)?;
+        let bake: f64 = manifest.timings.iter().map(|t| t.seconds).sum();
+        println!("  {}: baked in {bake:.3} s, {} files in {}", path.display(), manifest.files.len() + 1, args.out.join(path.file_stem().unwrap_or_default()).display());
+        Ok(())
+    })?;
+    let failed: Vec<String> = results.iter().zip(&args.env).filter_map(|(r, p)| r.as_ref().err().map(|e| format!("{}: {e:#}", p.display()))).collect();
+    let done = args.env.len() - failed.len();
+    println!("{done} of {} environments baked in {:.2} s ({:.3} s each)", args.env.len(), start.elapsed().as_secs_f64(), start.elapsed().as_secs_f64() / done.max(1) as f64);
+    if !failed.is_empty() {
+        return Err(anyhow::anyhow!("{} of {} environments failed (the others are written):\n  {}", failed.len(), args.env.len(), failed.join("\n  ")));
+    }
     Ok(())
 }
 
