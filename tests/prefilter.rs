@@ -181,3 +181,32 @@ fn exact_sums_gpu_match_cpu_and_keep_a_constant() {
     let rel = max_relative(&f.texels, &vec![c; f.texels.len()], 0.0);
     assert!(rel < 2e-6, "constant sky: {rel:e}");
 }
+
+/// The calibration kernel (the cost model's limits, `splitsum::cost::measure_machine`)
+/// computes the same values on the GPU as on the CPU for each kind of work, so both
+/// backends are timed on the same work; and the summed mode's values are the exact sum of
+/// the texels it reads (a closed form: every texel of the input is 1.5 in every channel,
+/// and `count` reads of it sum to `1.5·count`). Bound: the trilinear mode differs where
+/// the two compilers contract multiply–adds differently, far below half-float resolution
+/// (relative 1e-5); the sums of equal values are exact on both.
+#[test]
+fn calibration_kernel_gpu_matches_cpu() {
+    use splitsum::backend::{Backend, Kernels};
+    use splitsum_shaders::calibrate::Rate;
+    use splitsum_shaders::cubemap::CubeLayout;
+    let layout = CubeLayout::new(16, CubeLayout::full_chain(16));
+    let varied: Vec<Vec4> = (0..layout.texel_count()).map(|i| Vec4::new(1.0 + (i % 7) as f32, 0.5, 2.0 + (i % 3) as f32, 1.0)).collect();
+    let flat = vec![Vec4::splat(1.5); layout.texel_count() as usize];
+    let Backend::Gpu(g) = support::gpu() else { panic!("a GPU backend") };
+    let cpu = splitsum::backend::Cpu;
+    for (rate, texels, count) in [(Rate::Filtered, &varied, 64), (Rate::Summed, &flat, 1000), (Rate::Arithmetic, &varied, 500)] {
+        let gs = g.read(&g.calibrate(&g.upload("t", texels).unwrap(), layout, rate, 8, count).unwrap()).unwrap();
+        let cs = cpu.calibrate(texels, layout, rate, 8, count).unwrap();
+        let worst = gs.iter().zip(&cs).flat_map(|(a, b)| (0..4).map(move |c| ((a[c] - b[c]) / b[c].abs().max(1e-6)).abs())).fold(0.0f32, f32::max);
+        println!("calibration {rate:?}: max relative GPU-CPU difference {worst:.2e}");
+        assert!(worst <= 1e-5, "{rate:?}: GPU and CPU differ by {worst:e}");
+        if rate == Rate::Summed {
+            assert!(cs.iter().chain(&gs).all(|v| *v == Vec4::splat(1.5 * count as f32)), "summed reads are exact");
+        }
+    }
+}

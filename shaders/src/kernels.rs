@@ -13,7 +13,7 @@
 use crate::brdf::microfacet::Masking;
 use crate::cubemap::{self, CubeLayout};
 use crate::math::MeanPartial;
-use crate::{equirect, half, irradiance, lut, prefilter};
+use crate::{calibrate, equirect, half, irradiance, lut, prefilter};
 use bytemuck::{Pod, Zeroable};
 use spirv_std::glam::{UVec3, Vec4};
 use spirv_std::spirv;
@@ -501,5 +501,37 @@ pub fn read_cube(
         let d = cubemap::texel_dir(id.z, id.x, id.y, p.size);
         let v: Vec4 = cube.sample_by_lod(*sampler, d, p.level as f32);
         texels[(p.texel_offset + (id.z * p.size + id.y) * p.size + id.x) as usize] = half::clean_radiance(v);
+    }
+}
+
+/// Parameters of [`calibrate`].
+#[derive(Copy, Clone, Debug, Pod, Zeroable)]
+#[repr(C)]
+pub struct CalibrateParams {
+    /// The work measured (`calibrate::Rate` as `u32`).
+    pub rate: u32,
+    /// Face size of the output written (one texel per invocation).
+    pub size: u32,
+    /// Level-0 face size of the input cube.
+    pub src_size: u32,
+    /// Levels of the input cube.
+    pub src_levels: u32,
+    /// Steps of work per invocation.
+    pub count: u32,
+}
+
+/// One texel of a calibration run (`calibrate::texel`).
+#[spirv(compute(threads(8, 8)))]
+pub fn calibrate(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &CalibrateParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+) {
+    let s = p.size;
+    if id.x < s && id.y < s && id.z < cubemap::FACES {
+        let layout = CubeLayout::new(p.src_size, p.src_levels);
+        let i = ((id.z * s + id.y) * s + id.x) as usize;
+        out[i] = calibrate::texel(src, layout, calibrate::Rate::from_u32(p.rate), id.z, id.x, id.y, s, p.count);
     }
 }

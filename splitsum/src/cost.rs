@@ -247,3 +247,170 @@ pub fn estimate(job: &Job, cal: &Calibration) -> Cost {
     };
     Cost { gpu_seconds: step_seconds(job, cal, true).total(), cpu_seconds: step_seconds(job, cal, false).total(), bytes: bytes + 12 * width.pow(2) }
 }
+
+/// The work of one step, by kind: what the cost model of `runner bench` counts.
+///
+/// Texel reads are counted exactly from the job (a trilinear cube lookup reads 8 texels,
+/// an equirect area sample at least 4, a mip texel 4, a term of an exact sum 1).
+/// Floating-point operations are estimates, counted by reading the shared functions once:
+/// about 140 per GGX sample (the half vector ≈ 50, the lookup ≈ 70, the compensated sum
+/// ≈ 20), 80 per equirect area sample, 90 per term of an exact specular sum and 75 per
+/// irradiance term (texel direction, solid angle, weight, compensated sum), 130 per SH9
+/// texel. Bytes are the texels read and written (16 each).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Work {
+    /// Texel reads inside filtered lookups (trilinear cube lookups, equirect area samples,
+    /// mip reduction).
+    pub filtered_reads: f64,
+    /// Texel reads of whole levels in order (exact sums, irradiance, SH9).
+    pub summed_reads: f64,
+    /// Floating-point operations (estimated, see above).
+    pub flops: f64,
+    /// Bytes read and written.
+    pub bytes: f64,
+}
+
+impl std::ops::AddAssign for Work {
+    fn add_assign(&mut self, o: Work) {
+        self.filtered_reads += o.filtered_reads;
+        self.summed_reads += o.summed_reads;
+        self.flops += o.flops;
+        self.bytes += o.bytes;
+    }
+}
+
+/// The work of each step of `job`, in the order of [`Step::ALL`]. The BRDF table is a
+/// constant (`crate::table`): the defaults' is uploaded (its bytes only); another is
+/// integrated once per process, counted here as `lut::QUADRATURE_MEAN_EVALUATIONS` (or
+/// the samples) of about 60 operations per texel.
+pub fn step_work(job: &Job) -> [(Step, Work); 5] {
+    let mut out = Step::ALL.map(|s| (s, Work::default()));
+    fn at(out: &mut [(Step, Work); 5], s: Step) -> &mut Work {
+        &mut out.iter_mut().find(|(x, _)| *x == s).expect("every step").1
+    }
+    let source = job.source_layout();
+    {
+        let w = at(&mut out, Step::SourceCube);
+        let level0 = 6.0 * (job.source_size as f64).powi(2);
+        if let InputShape::Equirect { width, height } = job.input {
+            let points = level0 * (job.supersample as f64).powi(2);
+            w.filtered_reads += 4.0 * points + (width as f64) * (height as f64);
+            w.flops += 80.0 * points;
+        }
+        let mips = (source.texel_count() as f64 - level0).max(0.0);
+        w.filtered_reads += 4.0 * mips;
+        w.flops += 20.0 * mips;
+        w.bytes += 16.0 * (w.filtered_reads + source.texel_count() as f64);
+    }
+    if job.products.specular {
+        let w = at(&mut out, Step::Specular);
+        let layout = job.specular_layout();
+        for &l in &job.levels {
+            let texels = 6.0 * (layout.level_size(l) as f64).powi(2);
+            let m = l as usize;
+            if job.roughness_per_mip[m] <= 0.0 {
+                w.filtered_reads += texels;
+            } else if job.exact_levels[m] != splitsum_shaders::prefilter::SAMPLED {
+                let terms = texels * 6.0 * (source.level_size(job.exact_levels[m]) as f64).powi(2);
+                w.summed_reads += terms;
+                w.flops += 90.0 * terms;
+            } else {
+                let samples = texels * job.samples_per_mip[m] as f64;
+                w.filtered_reads += 8.0 * samples;
+                w.flops += 140.0 * samples;
+            }
+            w.bytes += 16.0 * texels;
+        }
+        w.bytes += 16.0 * (w.filtered_reads + w.summed_reads);
+    }
+    if job.products.irradiance {
+        let w = at(&mut out, Step::Irradiance);
+        let terms = 6.0 * (job.irradiance_size as f64).powi(2) * 6.0 * (job.irradiance_source as f64).powi(2);
+        w.summed_reads += terms;
+        w.flops += 75.0 * terms;
+        w.bytes += 16.0 * (terms + 6.0 * (job.irradiance_size as f64).powi(2));
+    }
+    if job.products.sh9 {
+        let w = at(&mut out, Step::Sh9);
+        let texels = 6.0 * (job.sh_source as f64).powi(2);
+        w.summed_reads += texels;
+        w.flops += 130.0 * texels;
+        w.bytes += 16.0 * texels;
+    }
+    if job.products.lut {
+        let w = at(&mut out, Step::BrdfTable);
+        let texels = (job.lut_size as f64).powi(2);
+        if crate::table::TableKey::of(job) != crate::table::TableKey::EMBEDDED {
+            let per_texel = match job.lut_method {
+                TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
+                TableMethod::Sampled => job.lut_samples,
+            };
+            w.flops += 60.0 * texels * per_texel as f64;
+        }
+        w.bytes += 16.0 * texels;
+    }
+    out
+}
+
+/// What a device does per second on each kind of [`Work`], measured by the calibration
+/// kernel (`splitsum_shaders::calibrate`) on that device: the cost model's limits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Machine {
+    /// Texel reads per second inside trilinear cube lookups.
+    pub filtered_reads: f64,
+    /// Texel reads per second of a level summed in order.
+    pub summed_reads: f64,
+    /// Floating-point operations per second (dependent multiply–adds).
+    pub flops: f64,
+}
+
+impl Machine {
+    /// The least time `w` can take on this machine: its slowest kind of work at the
+    /// measured rate (the kinds are taken to overlap, as a GPU's memory and arithmetic do),
+    /// and which kind that is.
+    pub fn limit(&self, w: &Work) -> (f64, &'static str) {
+        [(w.filtered_reads / self.filtered_reads, "filtered reads"), (w.summed_reads / self.summed_reads, "summed reads"), (w.flops / self.flops, "arithmetic")]
+            .into_iter()
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .expect("three kinds")
+    }
+}
+
+/// Runs the calibration kernel on `backend` and returns its rates: each kind of work on a
+/// 128² cube with its mip chain (values from a fixed hash, positive and finite), timed
+/// after a first run that warms the pipeline and caches; the faster of two runs is kept.
+pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Result<Machine> {
+    use crate::backend::{Backend, Kernels};
+    use splitsum_shaders::calibrate::Rate;
+    use splitsum_shaders::cubemap::CubeLayout;
+    use splitsum_shaders::glam::Vec4;
+    fn rate<K: Kernels>(k: &K, rate: Rate, size: u32, count: u32) -> crate::error::Result<f64> {
+        let layout = CubeLayout::new(128, CubeLayout::full_chain(128));
+        let texels: Vec<Vec4> = (0..layout.texel_count())
+            .map(|i| {
+                let h = i.wrapping_mul(2_654_435_761);
+                Vec4::new((h >> 8 & 255) as f32 / 64.0, (h >> 16 & 255) as f32 / 64.0, (h >> 24) as f32 / 64.0, 1.0)
+            })
+            .collect();
+        let src = k.upload("calibration cube", &texels)?;
+        let mut best = f64::INFINITY;
+        for run in 0..3 {
+            k.finish()?;
+            let t = web_time::Instant::now();
+            let out = k.calibrate(&src, layout, rate, size, count)?;
+            k.finish()?;
+            if run > 0 {
+                best = best.min(t.elapsed().as_secs_f64());
+            }
+            drop(out);
+        }
+        Ok(6.0 * (size as f64).powi(2) * count as f64 * rate.per_step() as f64 / best)
+    }
+    let measure = |k: &dyn Fn(Rate, u32, u32) -> crate::error::Result<f64>| -> crate::error::Result<Machine> {
+        Ok(Machine { filtered_reads: k(Rate::Filtered, 64, 128)?, summed_reads: k(Rate::Summed, 32, 8192)?, flops: k(Rate::Arithmetic, 64, 4096)? })
+    };
+    match backend {
+        Backend::Gpu(g) => measure(&|r, s, c| rate(&**g, r, s, c)),
+        Backend::Cpu => measure(&|r, s, c| rate(&crate::backend::Cpu, r, s, c)),
+    }
+}

@@ -1,4 +1,6 @@
-//! `runner bench`: bake time per product on each backend, and peak memory.
+//! `runner bench`: bake time per step on each backend against the cost model (each step's
+//! work counted from the job, the device's limits measured by the calibration kernel),
+//! and peak memory.
 
 use super::*;
 use crate::bake;
@@ -59,8 +61,31 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
             }
         }
         println!("{}", backend.describe());
+        let machine = splitsum::cost::measure_machine(&backend)?;
+        println!(
+            "  limits by the calibration kernel: {:.2} G filtered texel reads/s, {:.2} G summed texel reads/s, {:.1} GFLOP/s",
+            machine.filtered_reads * 1e-9,
+            machine.summed_reads * 1e-9,
+            machine.flops * 1e-9
+        );
+        println!("  {:<12} {:>9} {:>10} {:>10} {:>9} {:>8} {:>10} {:>9}  bound by", "step", "seconds", "filt. M", "summ. M", "GFLOP", "MB", "limit s", "of limit");
+        let work = splitsum::cost::step_work(&job);
         for t in &best {
-            println!("  {:<12} {:>9.3} s", t.step.name(), t.seconds);
+            let w = work.iter().find(|(s, _)| *s == t.step).expect("every step").1;
+            let (limit, bound) = machine.limit(&w);
+            let fraction = if t.seconds > 0.0 && limit > 0.0 { format!("{:.0} %", 100.0 * limit / t.seconds) } else { "-".into() };
+            println!(
+                "  {:<12} {:>9.3} {:>10.1} {:>10.1} {:>9.2} {:>8.1} {:>10.4} {:>9}  {}",
+                t.step.name(),
+                t.seconds,
+                w.filtered_reads * 1e-6,
+                w.summed_reads * 1e-6,
+                w.flops * 1e-9,
+                w.bytes * 1e-6,
+                limit,
+                fraction,
+                if limit > 0.0 { bound } else { "-" }
+            );
         }
         println!("  {:<12} {:>9.3} s", "total", best.iter().map(|t| t.seconds).sum::<f64>());
     }

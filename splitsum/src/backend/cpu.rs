@@ -13,6 +13,7 @@ use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance;
 use splitsum_shaders::kernels::{self, ProbeParams};
+use splitsum_shaders::calibrate::{self, Rate};
 use splitsum_shaders::{equirect, lut, prefilter};
 
 /// The CPU backend (rayon's global thread pool).
@@ -152,6 +153,12 @@ impl Kernels for Cpu {
 
     fn brdf_table(&self, size: u32, masking: Masking) -> Result<Vec<Vec4>> {
         Ok(table("brdf table", size, |x, y| lut::texel_quadrature(x, y, size, masking).extend(0.0).extend(0.0)))
+    }
+
+    fn calibrate(&self, src: &Vec<Vec4>, src_layout: CubeLayout, rate: Rate, size: u32, count: u32) -> Result<Vec<Vec4>> {
+        let mut texels = vec![Vec4::ZERO; (FACES * size * size) as usize];
+        fill_level(&mut texels, size, &ProgressBar::hidden(), |face, x, y| calibrate::texel(src, src_layout, rate, face, x, y, size, count));
+        Ok(texels)
     }
 
     fn probe_raw(&self, p: ProbeParams, texels: &[Vec4], probes: &[Vec4], terms: u32) -> Result<Vec<Vec4>> {

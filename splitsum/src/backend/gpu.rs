@@ -19,7 +19,8 @@ use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
-use splitsum_shaders::kernels::{DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, ResolveParams, TableParams};
+use splitsum_shaders::calibrate::Rate;
+use splitsum_shaders::kernels::{CalibrateParams, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, ResolveParams, TableParams};
 use splitsum_shaders::{equirect, lut, prefilter};
 use splitsum_spirv::{self as spirv, Binding, Dimension, EntryPoint, Resource, Stage};
 use std::borrow::Cow;
@@ -847,6 +848,13 @@ impl Kernels for Gpu {
         let out = self.texels("brdf table", n)?;
         let per_texel = lut::QUADRATURE_MEAN_EVALUATIONS;
         self.table_rows(&spirv::KERNELS_BRDF_TABLE, size, per_texel, &out.buffer, |row_offset| TableParams { size, masking: masking as u32, row_offset });
+        Ok(out)
+    }
+
+    fn calibrate(&self, src: &Texels, src_layout: CubeLayout, rate: Rate, size: u32, count: u32) -> Result<Texels> {
+        let out = self.texels("calibration", FACES * size * size)?;
+        let p = CalibrateParams { rate: rate as u32, size, src_size: src_layout.size, src_levels: src_layout.levels, count };
+        self.run(&[Dispatch { kernel: &spirv::KERNELS_CALIBRATE, params: bytemuck::bytes_of(&p), input: Some(&src.buffer), output: &out.buffer, invocations: [size, size, FACES] }]);
         Ok(out)
     }
 

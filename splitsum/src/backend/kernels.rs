@@ -3,6 +3,7 @@
 use crate::error::Result;
 use crate::texture::{Equirect, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::calibrate::Rate;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
@@ -65,6 +66,9 @@ pub trait Kernels {
     fn brdf_lut(&self, size: u32, samples: u32) -> Result<Self::Texels>;
     /// The `size`² BRDF table by deterministic quadrature with `masking`.
     fn brdf_table(&self, size: u32, masking: Masking) -> Result<Self::Texels>;
+    /// A calibration run (`calibrate::texel`): `count` steps of work `rate` per texel of a
+    /// `size`² cube, over `src` (a cube of `src_layout`); for the cost model.
+    fn calibrate(&self, src: &Self::Texels, src_layout: CubeLayout, rate: Rate, size: u32, count: u32) -> Result<Self::Texels>;
     /// `probes` evaluated with `params` over `cube` (see `kernels::probe_chunk`): raw
     /// results, three `Vec4` per probe.
     fn probe_raw(&self, params: ProbeParams, texels: &[Vec4], probes: &[Vec4], terms: u32) -> Result<Vec<Vec4>>;
