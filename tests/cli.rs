@@ -277,3 +277,17 @@ fn a_batch_writes_each_environment_and_survives_a_bad_one() {
     assert!(e.contains("ENV") && e.contains("both"), "{e}");
     assert!(!o2.exists(), "nothing is written when two outputs collide");
 }
+
+/// `--budget` chooses the sample count and the irradiance source itself: beside either
+/// flag, or not a positive number, it is refused by name before anything is written.
+#[test]
+fn a_budget_is_refused_beside_what_it_chooses() {
+    let d = scratch("budget");
+    let out = d.join("out");
+    let (o, env) = (out.to_str().unwrap(), repo("splitsum/assets/courtyard.exr"));
+    let e = err(&["bake", &env, "--backend", "cpu", "--budget", "0.5", "--samples", "64", "--out", o]);
+    assert!(e.contains("--budget") && e.contains("--samples"), "{e}");
+    let e = err(&["bake", &env, "--backend", "cpu", "--budget", "0", "--out", o]);
+    assert!(e.contains("--budget") && e.contains("positive"), "{e}");
+    assert!(!out.exists());
+}

@@ -449,3 +449,27 @@ fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
     assert_eq!(std::fs::read_dir(&cache).unwrap().count(), entries, "no new cache entry");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The time-budget planner (`splitsum::cost::for_budget`) on a fixed machine: a larger
+/// budget never predicts a larger error, every choice whose estimate fits is within its
+/// budget, and a budget below every candidate gets the cheapest (stated as over). The
+/// machine's rates are the calibration kernel's on lavapipe here (rounded), fixed so the
+/// test does not time anything.
+#[test]
+fn a_larger_budget_never_predicts_more_error() {
+    use splitsum::cost::{Machine, for_budget};
+    let machine = Machine { filtered_reads: 0.25e9, summed_reads: 0.75e9, flops: 18e9 };
+    let shape = splitsum::InputShape::Equirect { width: 1024, height: 512 };
+    let settings = splitsum::Settings::default();
+    let cal = Calibration::default();
+    let mut last = f64::INFINITY;
+    let mut cheapest = f64::INFINITY;
+    for budget in [0.01, 0.1, 0.3, 0.5, 1.0, 2.0, 10.0] {
+        let (chosen, error, seconds) = for_budget(&settings, shape, splitsum::Products::ALL, budget, &machine, &cal).expect("a choice");
+        println!("budget {budget}: {} samples, irradiance {:?}, error {error:.4}, estimate {seconds:.3}", chosen.samples, chosen.irradiance_source);
+        assert!(error <= last + 1e-12, "budget {budget}: error {error} above the smaller budget's {last}");
+        cheapest = cheapest.min(seconds);
+        assert!(seconds <= budget || seconds <= cheapest + 1e-12, "budget {budget}: {seconds} s neither fits nor is the cheapest");
+        last = error;
+    }
+}

@@ -414,3 +414,45 @@ pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Resul
         Backend::Cpu => measure(&|r, s, c| rate(&crate::backend::Cpu, r, s, c)),
     }
 }
+
+/// The share of its limit a step reaches, for turning the cost model's limits into a time
+/// estimate on a device measured only by the calibration kernel: the lowest of the steps
+/// that dominate a bake on lavapipe and on 2 CPU cores (`runner bench` of the defaults on
+/// city.exr: source cube 40–74 %, specular 59–83 %, irradiance 34–46 %).
+pub const SHARE_OF_LIMIT: f64 = 0.4;
+
+/// The settings a bake within `budget` seconds on `machine` should use: among the
+/// specular sample counts and irradiance source sizes the error model `cal` measured, the
+/// pair with the lowest predicted error whose estimated time fits (the specular bake's
+/// share of the shaded colour's error, its mean over the calibrated roughness bands, plus
+/// the irradiance's error). Returns the settings, the predicted error and the estimated
+/// seconds; when nothing fits, the cheapest pair, whose estimate then exceeds `budget`.
+pub fn for_budget(given: &crate::settings::Settings, shape: InputShape, products: crate::settings::Products, budget: f64, machine: &Machine, cal: &Calibration) -> crate::error::Result<(crate::settings::Settings, f64, f64)> {
+    // Sample counts within the measured range only: the error model is flat outside it.
+    let measured: Vec<u32> = cal.prefilter.iter().flat_map(|(_, t)| t.iter().map(|&(n, _)| n)).collect();
+    let (lo, hi) = (measured.iter().copied().min().unwrap_or(64), measured.iter().copied().max().unwrap_or(64));
+    let mut samples: Vec<u32> = measured.iter().copied().chain([8, 16, 32, 64, 128, 256, 512, 1024]).filter(|&n| n >= lo && n <= hi).collect();
+    samples.sort_unstable();
+    samples.dedup();
+    let source = given.resolve(shape, products)?.source_size;
+    let sources: Vec<(u32, f64)> = cal.irradiance.iter().copied().filter(|&(s, _)| s <= source).collect();
+    let mut best: Option<(crate::settings::Settings, f64, f64)> = None;
+    let mut cheapest: Option<(crate::settings::Settings, f64, f64)> = None;
+    for &n in &samples {
+        for &(s, irradiance_error) in &sources {
+            let settings = crate::settings::Settings { samples: n, irradiance_source: Some(s), ..given.clone() };
+            let Ok(job) = settings.resolve(shape, products) else { continue };
+            let seconds: f64 = step_work(&job).iter().map(|(_, w)| machine.limit(w).0).sum::<f64>() / SHARE_OF_LIMIT;
+            let specular_error = cal.prefilter.iter().map(|(r, _)| cal.prefilter_error(*r, n)).sum::<f64>() / cal.prefilter.len().max(1) as f64;
+            let error = if products.specular { specular_error } else { 0.0 } + if products.irradiance { irradiance_error } else { 0.0 };
+            let candidate = (settings, error, seconds);
+            if seconds <= budget && best.as_ref().is_none_or(|b| error < b.1 || (error == b.1 && seconds < b.2)) {
+                best = Some(candidate.clone());
+            }
+            if cheapest.as_ref().is_none_or(|c| seconds < c.2) {
+                cheapest = Some(candidate);
+            }
+        }
+    }
+    Ok(best.or(cheapest).expect("at least one candidate resolves"))
+}

@@ -23,6 +23,11 @@ pub(super) struct BakeArgs {
     /// Where to bake.
     #[arg(long, value_parser = choice::<BackendKind>(), default_value = "gpu")]
     backend: BackendKind,
+    /// A time budget per bake, in seconds, on this device: the specular sample count and
+    /// the irradiance source are chosen for the lowest predicted error whose estimate fits
+    /// (the cost model's limits, measured by the calibration kernel first).
+    #[arg(long, value_name = "SECONDS")]
+    budget: Option<f64>,
     /// Replace NaN and -inf texels by 0 and +inf by the channel's largest finite value
     /// instead of refusing the file.
     #[arg(long)]
@@ -46,7 +51,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
         return batch_command(args, given);
     }
     let env_path = args.env[0].clone();
-    let settings = args.quality.settings();
+    let mut settings = args.quality.settings();
     // An engine target bakes only what its engine reads.
     let products = settings.target.products();
     // The flags are checked before anything is read or written.
@@ -54,8 +59,11 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     refuse_unread(given, &settings, products, env_path.is_dir())?;
     let out = files::OutputDir::begin(&args.out, "--out")?;
     let (env, input) = load_input(&env_path, args.sanitize, source_size)?;
-    let job = settings.resolve(InputShape::of(&env), products)?;
     let backend = Backend::open(args.backend)?;
+    if let Some(budget) = args.budget {
+        settings = within_budget(&settings, InputShape::of(&env), products, budget, &backend, given)?;
+    }
+    let job = settings.resolve(InputShape::of(&env), products)?;
     bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.scene.force)?;
     println!("baking {} on {} for {}", env_path.display(), backend.describe(), job.target.name());
     for a in job.adjustments() {
@@ -77,6 +85,30 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     }
     println!("wrote {} files to {}", manifest.files.len() + 1, args.out.display());
     Ok(())
+}
+
+/// The settings for a bake within `budget` seconds on `backend` (`splitsum::cost::for_budget`),
+/// stated; refuses `--budget` beside a flag it would choose.
+fn within_budget(settings: &splitsum::Settings, shape: InputShape, products: splitsum::Products, budget: f64, backend: &Backend, given: &[String]) -> anyhow::Result<splitsum::Settings> {
+    if !(budget > 0.0 && budget.is_finite()) {
+        return Err(Usage::new(format!("--budget must be a positive number of seconds, not {budget}")).into());
+    }
+    for f in [flag_of(splitsum::Field::Samples), flag_of(splitsum::Field::IrradianceSource)] {
+        if given.contains(&f) {
+            return Err(Usage::new(format!("--budget chooses {f} itself: give one or the other")).into());
+        }
+    }
+    let machine = splitsum::cost::measure_machine(backend)?;
+    let (chosen, error, seconds) = splitsum::cost::for_budget(settings, shape, products, budget, &machine, &splitsum::cost::Calibration::default())?;
+    let fits = if seconds <= budget { "fits" } else { "is the cheapest, and still over" };
+    println!(
+        "budget {budget} s on {}: {} samples at mip 1, irradiance from {}², predicted error {:.1} %, estimated {seconds:.3} s ({fits} the budget)",
+        backend.describe(),
+        chosen.samples,
+        chosen.irradiance_source.unwrap_or_default(),
+        100.0 * error
+    );
+    Ok(chosen)
 }
 
 /// Writes `baked` into the output folder `out` and commits it.

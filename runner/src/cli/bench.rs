@@ -18,6 +18,11 @@ pub(super) struct BenchArgs {
     /// Runs per backend; the table shows the fastest.
     #[arg(long, default_value_t = 1)]
     runs: u32,
+    /// Time budgets (seconds) for the budget-to-error curve: for each, the settings
+    /// `--budget` would choose on each backend, their predicted error, estimated and
+    /// measured time.
+    #[arg(long, value_delimiter = ',', value_name = "SECONDS")]
+    budgets: Vec<f64>,
     /// Run even if the bake is estimated to take over an hour.
     #[arg(long)]
     force: bool,
@@ -88,6 +93,16 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
             );
         }
         println!("  {:<12} {:>9.3} s", "total", best.iter().map(|t| t.seconds).sum::<f64>());
+        if !args.budgets.is_empty() {
+            println!("  budget-to-error curve (predicted error: the built-in error model, end to end)");
+            println!("  {:>9} {:>8} {:>11} {:>10} {:>11} {:>10}", "budget s", "samples", "irradiance", "error", "estimate s", "bake s");
+            for &budget in &args.budgets {
+                let (chosen, error, estimate) = splitsum::cost::for_budget(&settings, InputShape::of(&env), Products::ALL, budget, &machine, &splitsum::cost::Calibration::default())?;
+                let job = chosen.resolve(InputShape::of(&env), Products::ALL)?;
+                let seconds: f64 = bake::bake_job(&backend, &env, &job)?.timings.iter().map(|t| t.seconds).sum();
+                println!("  {budget:>9} {:>8} {:>10}² {:>9.1} % {estimate:>11.3} {seconds:>10.3}", chosen.samples, job.irradiance_source, 100.0 * error);
+            }
+        }
     }
     if let Some(peak) = peak_memory() {
         println!("peak memory of this process (VmHWM, all backends so far): {:.0} MiB", peak as f64 / 1048576.0);
