@@ -8,8 +8,8 @@
 //!   neighbourhood, as the GGX samples of a prefilter do;
 //! - [`Rate::Summed`]: texel reads of a level in order, every invocation reading the same
 //!   texel at the same time, as the exact sums of the irradiance and the rough mips do;
-//! - [`Rate::Arithmetic`]: dependent multiply–adds on four lanes (8 floating-point
-//!   operations each), no memory.
+//! - [`Rate::Arithmetic`]: multiply–adds in four independent chains of four lanes (32
+//!   floating-point operations a step), no memory.
 
 use crate::cubemap::{self, CubeLayout};
 use crate::math;
@@ -43,7 +43,7 @@ impl Rate {
         match self {
             Rate::Filtered => 8,
             Rate::Summed => 1,
-            Rate::Arithmetic => 8,
+            Rate::Arithmetic => 32,
         }
     }
 }
@@ -65,7 +65,9 @@ pub fn texel(src: &[Vec4], layout: CubeLayout, rate: Rate, face: u32, x: u32, y:
             }
         }
         Rate::Summed => {
-            let m = layout.texel_count();
+            // A range the size of a summed level with its geometry (2·6·16² texels, 48 KiB):
+            // as cache-resident as the bake's sums are.
+            let m = if layout.texel_count() < 3072 { layout.texel_count() } else { 3072 };
             let mut i = 0u32;
             while k < count {
                 acc += src[i as usize];
@@ -77,14 +79,20 @@ pub fn texel(src: &[Vec4], layout: CubeLayout, rate: Rate, face: u32, x: u32, y:
             }
         }
         Rate::Arithmetic => {
-            let mut v = Vec4::new(x as f32, y as f32, face as f32, 1.0) * 1e-3;
+            // Four independent chains of four lanes, so that the rate is the units'
+            // throughput, not one chain's latency.
+            let v = Vec4::new(x as f32, y as f32, face as f32, 1.0) * 1e-3;
+            let (mut v0, mut v1, mut v2, mut v3) = (v, v + Vec4::ONE, v * 0.5, v + Vec4::splat(2.0));
             let a = Vec4::splat(0.999_9);
             let b = Vec4::splat(math::FRAC_1_PI * 1e-4);
             while k < count {
-                v = v * a + b;
+                v0 = v0 * a + b;
+                v1 = v1 * a + b;
+                v2 = v2 * a + b;
+                v3 = v3 * a + b;
                 k += 1;
             }
-            acc = v;
+            acc = v0 + v1 + v2 + v3;
         }
     }
     acc

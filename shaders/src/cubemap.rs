@@ -321,15 +321,43 @@ pub fn downsample_texel(texels: &[Vec4], layout: CubeLayout, level: u32, face: u
     math::finite4(acc)
 }
 
+/// The unit direction (`xyz`) and solid angle (`w`) of texel `t` of a level with faces
+/// `s` wide, texels numbered face by face, row by row: what [`weighted_level_sum`] weighs
+/// a texel by. Every output texel of an exact sum needs the same ones, so a sum over a
+/// level reads them from a table of them made once ([`level_geometry`]) instead of
+/// computing two triangles' solid angles per term again for every output texel.
+#[inline]
+pub fn texel_geometry(t: u32, s: u32) -> Vec4 {
+    let face = t / (s * s);
+    let y = (t / s) % s;
+    let x = t % s;
+    texel_dir(face, x, y, s).extend(texel_solid_angle(x, y, s))
+}
+
+/// [`texel_geometry`] of every texel of a level with faces `s` wide, in order.
+#[cfg(not(target_arch = "spirv"))]
+pub fn level_geometry(s: u32) -> impl Iterator<Item = Vec4> {
+    (0..FACES * s * s).map(move |t| texel_geometry(t, s))
+}
+
+/// Where [`weighted_level_sum`] finds the geometry of the level's texels: computed per term
+/// (no table).
+pub const INLINE_GEOMETRY: u32 = u32::MAX;
+
 /// Adds texels `start .. start + count` of `level` (numbered face by face, row by row) to
 /// the weighted mean `p`, each weighted by `weight(direction, solid angle)` (zero or
 /// negative weights skip the texel): the exact sums of the irradiance convolution and of the
-/// exact prefilter, with compensated running sums carried from chunk to chunk.
+/// exact prefilter, with compensated running sums carried from chunk to chunk. The texels'
+/// geometry ([`texel_geometry`]) is read from `src[geometry + t]` (a table placed after the
+/// texels), or computed per term when `geometry` is [`INLINE_GEOMETRY`]; both give the same
+/// values, bit for bit, when the table was computed by the same compiler.
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub fn weighted_level_sum(
     src: &[Vec4],
     layout: CubeLayout,
     level: u32,
+    geometry: u32,
     start: u32,
     count: u32,
     p: MeanPartial,
@@ -341,16 +369,28 @@ pub fn weighted_level_sum(
     let mut wsum = CompensatedSum::resume(p.weight.x, p.weight.y);
     let mut t = start;
     let end = start + count;
-    while t < end {
-        let face = t / (s * s);
-        let y = (t / s) % s;
-        let x = t % s;
-        let w = weight(texel_dir(face, x, y, s), texel_solid_angle(x, y, s));
-        if w > 0.0 {
-            acc.add(src[(base + t) as usize] * w);
-            wsum.add(w);
+    // Two loops, not a choice per term: a GPU compiler that runs lanes under masks would
+    // otherwise compute the inline geometry for every term even when a table holds it.
+    if geometry == INLINE_GEOMETRY {
+        while t < end {
+            let g = texel_geometry(t, s);
+            let w = weight(g.truncate(), g.w);
+            if w > 0.0 {
+                acc.add(src[(base + t) as usize] * w);
+                wsum.add(w);
+            }
+            t += 1;
         }
-        t += 1;
+    } else {
+        while t < end {
+            let g = src[(geometry + t) as usize];
+            let w = weight(g.truncate(), g.w);
+            if w > 0.0 {
+                acc.add(src[(base + t) as usize] * w);
+                wsum.add(w);
+            }
+            t += 1;
+        }
     }
     let (sum, carry) = acc.parts();
     let (w, wc) = wsum.parts();

@@ -82,19 +82,22 @@ pub fn sh9_polynomial(coeffs: &[Vec4; SH9]) -> [Vec3; SH9] {
 }
 
 /// `E(n)/π` at normal `n` by the exact cosine-weighted sum over every texel of `level` of
-/// the source cube: [`accumulate`] over chunks of `math::CHUNK` texels, then the mean.
-pub fn convolve_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3) -> Vec4 {
+/// the source cube: [`accumulate`] over chunks of `math::CHUNK` texels, then the mean. The
+/// level's geometry is at `src[geometry..]` or computed per term (see
+/// `cubemap::weighted_level_sum`).
+pub fn convolve_dir(src: &[Vec4], layout: CubeLayout, level: u32, geometry: u32, n: Vec3) -> Vec4 {
     let s = layout.level_size(level);
-    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| accumulate(src, layout, level, n, start, c, p))
+    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| accumulate(src, layout, level, geometry, n, start, c, p))
 }
 
 /// Adds texels `start .. start + count` of `level` (numbered face by face, row by row) to
 /// the cosine-weighted mean for normal `n`.
-pub fn accumulate(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
+#[allow(clippy::too_many_arguments)]
+pub fn accumulate(src: &[Vec4], layout: CubeLayout, level: u32, geometry: u32, n: Vec3, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
     // A zero or non-finite normal is read as +z: never an empty hemisphere, never NaN.
     let n = crate::sampling::normalize_or(n, Vec3::Z);
     // Scaled by 1/(4π) so the weights sum to about 1/4: no overflow.
-    cubemap::weighted_level_sum(src, layout, level, start, count, p, |d, omega| math::max(n.dot(d), 0.0) * omega * (0.25 * math::FRAC_1_PI))
+    cubemap::weighted_level_sum(src, layout, level, geometry, start, count, p, |d, omega| math::max(n.dot(d), 0.0) * omega * (0.25 * math::FRAC_1_PI))
 }
 
 /// The contribution of row `y` of `face` of `level` to the SH projection: nine RGB

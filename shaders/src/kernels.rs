@@ -196,10 +196,12 @@ fn store_partial(accum: &mut [Vec4], i: usize, p: MeanPartial) {
     accum[3 * i + 2] = p.weight;
 }
 
-/// One chunk of samples of one texel of one level of the prefiltered specular cube: adds
-/// them to the texel's partial sums in `accum` (three `Vec4` per texel); [`resolve_means`]
-/// resolves the means once every chunk has run (`prefilter::accumulate`,
-/// `MeanPartial::resolve`).
+/// One chunk of GGX samples of one texel of one level of the prefiltered specular cube:
+/// adds them to the texel's partial sums in `accum` (three `Vec4` per texel);
+/// [`resolve_means`] resolves the means once every chunk has run
+/// (`prefilter::accumulate`, `MeanPartial::resolve`). The exact sums are a kernel of their
+/// own ([`prefilter_exact`]), not a branch here: a compiler that runs lanes under masks
+/// (llvmpipe) would run both loops.
 #[spirv(compute(threads(8, 8)))]
 pub fn prefilter_specular(
     #[spirv(global_invocation_id)] id: UVec3,
@@ -213,12 +215,27 @@ pub fn prefilter_specular(
         let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
         let n = cubemap::texel_dir(id.z, id.x, id.y, s);
         let partial = load_partial(accum, i);
-        let next = if p.exact_level == prefilter::SAMPLED {
-            prefilter::accumulate(src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial)
-        } else {
-            prefilter::exact_accumulate(src, layout, p.exact_level, n, p.roughness, p.start, p.count, partial)
-        };
-        store_partial(accum, i, next);
+        store_partial(accum, i, prefilter::accumulate(src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial));
+    }
+}
+
+/// One chunk of source texels of the exact sum (`prefilter::exact_accumulate` over level
+/// `exact_level`) of one texel of one level of the prefiltered specular cube, as
+/// [`prefilter_specular`] does for samples.
+#[spirv(compute(threads(8, 8)))]
+pub fn prefilter_exact(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &PrefilterParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
+) {
+    let s = p.dst_size;
+    if id.x < s && id.y < s && id.z < cubemap::FACES {
+        let layout = CubeLayout::new(p.src_size, p.src_levels);
+        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
+        let n = cubemap::texel_dir(id.z, id.x, id.y, s);
+        let partial = load_partial(accum, i);
+        store_partial(accum, i, prefilter::exact_accumulate(src, layout, p.exact_level, n, p.roughness, p.start, p.count, partial));
     }
 }
 
@@ -238,6 +255,9 @@ pub struct IrradianceParams {
     pub start: u32,
     /// Source texels in this chunk (at most `math::CHUNK`).
     pub count: u32,
+    /// Index in `src` of the summed level's geometry table (`cubemap::level_geometry`),
+    /// placed after the texels, or `cubemap::INLINE_GEOMETRY`.
+    pub geometry: u32,
 }
 
 /// One chunk of source texels for one texel of the irradiance cube: adds them to its
@@ -255,7 +275,7 @@ pub fn irradiance_cube(
         let i = ((id.z * s + id.y) * s + id.x) as usize;
         let n = cubemap::texel_dir(id.z, id.x, id.y, s);
         let partial = load_partial(accum, i);
-        store_partial(accum, i, irradiance::accumulate(src, layout, p.src_level, n, p.start, p.count, partial));
+        store_partial(accum, i, irradiance::accumulate(src, layout, p.src_level, p.geometry, n, p.start, p.count, partial));
     }
 }
 
@@ -335,7 +355,7 @@ pub fn probe_chunk(p: &ProbeParams, input: &[Vec4], q: Vec4, out: &mut [Vec4], i
         store_partial(out, i, prefilter::accumulate(input, layout, q.truncate(), q.w, p.samples, p.start, p.chunk, p.lod_bias, partial));
     } else if p.mode == ProbeMode::Irradiance as u32 {
         let partial = load_partial(out, i);
-        store_partial(out, i, irradiance::accumulate(input, layout, p.src_level, q.truncate(), p.start, p.chunk, partial));
+        store_partial(out, i, irradiance::accumulate(input, layout, p.src_level, cubemap::INLINE_GEOMETRY, q.truncate(), p.start, p.chunk, partial));
     } else {
         out[3 * i] = cubemap::sample_lod(input, layout, q.truncate(), q.w);
     }

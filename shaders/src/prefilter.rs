@@ -132,6 +132,43 @@ pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, 
     p.resolve()
 }
 
+/// GGX sample `i` of `samples` for `alpha` (α = r²) in the tangent frame of the normal
+/// (`z` along it): the half vector (`xyz`), and in `w` the source level the sample reads,
+/// from its density `D(h)·(n·h) / (4·(v·h)) = D(h)/4` at `v = n` ([`source_lod`]; Karis
+/// 2013, with the filtered importance sampling of Křivánek & Colbert 2008). It depends on
+/// no texel: the GPU computes it per sample, the CPU backend once per level
+/// ([`ggx_samples`]) and reads it back ([`accumulate_samples`]), the same values.
+#[inline]
+pub fn ggx_sample(i: u32, samples: u32, alpha: f32, src_size: u32, lod_bias: f32) -> Vec4 {
+    let ht = sampling::sample_ggx_tangent(sampling::hammersley(i, samples), alpha);
+    let pdf = 0.25 * microfacet::d_ggx(ht.z, alpha);
+    ht.extend(source_lod(pdf, samples, src_size, lod_bias))
+}
+
+/// [`ggx_sample`] for every sample of a level of `roughness` with `samples` samples.
+#[cfg(not(target_arch = "spirv"))]
+pub fn ggx_samples(samples: u32, roughness: f32, src_size: u32, lod_bias: f32) -> impl Iterator<Item = Vec4> {
+    let total = samples.max(1);
+    let alpha = alpha_from_roughness(math::saturate(roughness));
+    (0..total).map(move |i| ggx_sample(i, total, alpha, src_size, lod_bias))
+}
+
+/// Adds GGX sample `g` ([`ggx_sample`]) around the unit normal `n` with tangent frame
+/// `(t, b)` to the sums: the light direction `l = 2(n·h)h − n` weighted by `n·l/N`, read
+/// trilinearly at the sample's source level.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn add_sample(src: &[Vec4], layout: CubeLayout, n: Vec3, t: Vec3, b: Vec3, g: Vec4, inv_count: f32, acc: &mut math::CompensatedSum4, wsum: &mut math::CompensatedSum) {
+    let h = t * g.x + b * g.y + n * g.z;
+    let l = h * (2.0 * g.z) - n;
+    let n_dot_l = n.dot(l);
+    if n_dot_l > 0.0 {
+        let w = n_dot_l * inv_count;
+        acc.add(cubemap::sample_lod(src, layout, l, g.w) * w);
+        wsum.add(w);
+    }
+}
+
 /// Adds GGX samples `start .. start + count` (of `samples` in all) around `n` to `p`.
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate(
@@ -157,23 +194,38 @@ pub fn accumulate(
     let mut i = start;
     let end = start + count;
     while i < end {
-        let ht = sampling::sample_ggx_tangent(sampling::hammersley(i, total), alpha);
-        let h = t * ht.x + b * ht.y + n * ht.z;
-        let n_dot_h = n.dot(h);
-        let l = h * (2.0 * n_dot_h) - n;
-        let n_dot_l = n.dot(l);
-        if n_dot_l > 0.0 {
-            let pdf = 0.25 * microfacet::d_ggx(n_dot_h, alpha);
-            let lod = source_lod(pdf, total, layout.size, lod_bias);
-            let w = n_dot_l * inv_count;
-            acc.add(cubemap::sample_lod(src, layout, l, lod) * w);
-            wsum.add(w);
-        }
+        add_sample(src, layout, n, t, b, ggx_sample(i, total, alpha, layout.size, lod_bias), inv_count, &mut acc, &mut wsum);
         i += 1;
     }
     let (sum, carry) = acc.parts();
     let (w, wc) = wsum.parts();
     MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
+}
+
+/// [`accumulate`] with the samples read from `table` (all of them, [`ggx_samples`]) instead
+/// of made per texel: the same values.
+pub fn accumulate_samples(src: &[Vec4], layout: CubeLayout, n: Vec3, table: &[Vec4], start: u32, count: u32, p: MeanPartial) -> MeanPartial {
+    let n = sampling::normalize_or(n, Vec3::Z);
+    let inv_count = 1.0 / table.len().max(1) as f32;
+    let mut acc = math::CompensatedSum4::resume(p.sum, p.carry);
+    let mut wsum = math::CompensatedSum::resume(p.weight.x, p.weight.y);
+    let (t, b) = sampling::orthonormal_basis(n);
+    let mut i = start;
+    let end = start + count;
+    while i < end {
+        add_sample(src, layout, n, t, b, table[i as usize], inv_count, &mut acc, &mut wsum);
+        i += 1;
+    }
+    let (sum, carry) = acc.parts();
+    let (w, wc) = wsum.parts();
+    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
+}
+
+/// [`prefilter_dir`] from a table of its samples ([`ggx_samples`] of a non-zero roughness):
+/// the same values, without making the samples again for every texel.
+#[cfg(not(target_arch = "spirv"))]
+pub fn prefilter_dir_samples(src: &[Vec4], layout: CubeLayout, n: Vec3, table: &[Vec4]) -> Vec4 {
+    MeanPartial::chunked(table.len().max(1) as u32, |start, c, p| accumulate_samples(src, layout, n, table, start, c, p))
 }
 
 /// At roughness 0 (a mirror) a `dst_size`-wide level is the source level of that size, bit
@@ -268,7 +320,7 @@ pub fn exact_accumulate(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, r
     let alpha = alpha_from_roughness(math::saturate(roughness));
     // D ≤ 1/(πα²) and Ω ≤ 4π/6: scaled by α² so no weight exceeds about 1.
     let scale = alpha * alpha;
-    cubemap::weighted_level_sum(src, layout, level, start, count, p, |l, omega| {
+    cubemap::weighted_level_sum(src, layout, level, cubemap::INLINE_GEOMETRY, start, count, p, |l, omega| {
         let n_dot_l = n.dot(l);
         if n_dot_l > 0.0 {
             let h = sampling::normalize_or(n + l, n);

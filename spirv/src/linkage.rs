@@ -160,6 +160,18 @@ pub const KERNELS_PACK_HALF: EntryPoint = EntryPoint {
     ],
 };
 
+/// `kernels_prefilter_exact`.
+pub const KERNELS_PREFILTER_EXACT: EntryPoint = EntryPoint {
+    name: "kernels_prefilter_exact",
+    stage: Stage::Compute,
+    workgroup_size: [8, 8, 1],
+    bindings: &[
+        Binding { group: 0, binding: 0, resource: Resource::Uniform },
+        Binding { group: 0, binding: 1, resource: Resource::Storage { read_only: true } },
+        Binding { group: 0, binding: 2, resource: Resource::Storage { read_only: false } },
+    ],
+};
+
 /// `kernels_prefilter_mirror`.
 pub const KERNELS_PREFILTER_MIRROR: EntryPoint = EntryPoint {
     name: "kernels_prefilter_mirror",
@@ -246,4 +258,4 @@ pub const KERNELS_UNPACK_ROWS: EntryPoint = EntryPoint {
 };
 
 /// Every compute entry point.
-pub const KERNELS: [EntryPoint; 16] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_CALIBRATE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9_PROJECT, KERNELS_PACK_HALF, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];
+pub const KERNELS: [EntryPoint; 17] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_CALIBRATE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9_PROJECT, KERNELS_PACK_HALF, KERNELS_PREFILTER_EXACT, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];

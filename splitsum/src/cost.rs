@@ -254,9 +254,9 @@ pub fn estimate(job: &Job, cal: &Calibration) -> Cost {
 /// an equirect area sample at least 4, a mip texel 4, a term of an exact sum 1).
 /// Floating-point operations are estimates, counted by reading the shared functions once:
 /// about 140 per GGX sample (the half vector ≈ 50, the lookup ≈ 70, the compensated sum
-/// ≈ 20), 80 per equirect area sample, 90 per term of an exact specular sum and 75 per
-/// irradiance term (texel direction, solid angle, weight, compensated sum), 130 per SH9
-/// texel. Bytes are the texels read and written (16 each).
+/// ≈ 20), 80 per equirect area sample, 90 per term of an exact specular sum (texel
+/// direction, solid angle, weight, compensated sum), 31 per irradiance term (its direction
+/// and solid angle read from a table: weight 7, compensated sums 24), 130 per SH9 texel. Bytes are the texels read and written (16 each).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Work {
     /// Texel reads inside filtered lookups (trilinear cube lookups, equirect area samples,
@@ -325,9 +325,10 @@ pub fn step_work(job: &Job) -> [(Step, Work); 5] {
     }
     if job.products.irradiance {
         let w = at(&mut out, Step::Irradiance);
+        // Each term reads the texel and its geometry (`cubemap::level_geometry`).
         let terms = 6.0 * (job.irradiance_size as f64).powi(2) * 6.0 * (job.irradiance_source as f64).powi(2);
-        w.summed_reads += terms;
-        w.flops += 75.0 * terms;
+        w.summed_reads += 2.0 * terms;
+        w.flops += 31.0 * terms;
         w.bytes += 16.0 * (terms + 6.0 * (job.irradiance_size as f64).powi(2));
     }
     if job.products.sh9 {
@@ -407,7 +408,7 @@ pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Resul
         Ok(6.0 * (size as f64).powi(2) * count as f64 * rate.per_step() as f64 / best)
     }
     let measure = |k: &dyn Fn(Rate, u32, u32) -> crate::error::Result<f64>| -> crate::error::Result<Machine> {
-        Ok(Machine { filtered_reads: k(Rate::Filtered, 64, 128)?, summed_reads: k(Rate::Summed, 32, 8192)?, flops: k(Rate::Arithmetic, 64, 4096)? })
+        Ok(Machine { filtered_reads: k(Rate::Filtered, 64, 128)?, summed_reads: k(Rate::Summed, 32, 8192)?, flops: k(Rate::Arithmetic, 64, 1024)? })
     };
     match backend {
         Backend::Gpu(g) => measure(&|r, s, c| rate(&**g, r, s, c)),

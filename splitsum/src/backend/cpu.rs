@@ -7,7 +7,7 @@ use crate::progress::bar as progress;
 use crate::texture::{Equirect, Sh9};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
-use splitsum_shaders::brdf::microfacet::Masking;
+use splitsum_shaders::brdf::{self, microfacet::Masking};
 use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
 use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
@@ -126,7 +126,13 @@ impl Kernels for Cpu {
             let start = out.level_offset(m) as usize;
             let level = &mut texels[start..start + (FACES * s * s) as usize];
             let (r, n, e) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
-            fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(src, src_layout, face, x, y, s, r, n, job.lod_bias, e));
+            if r > 0.0 && e == prefilter::SAMPLED && brdf::alpha_from_roughness(r) > 0.0 {
+                // The samples depend on no texel: made once for the level.
+                let table: Vec<Vec4> = prefilter::ggx_samples(n, r, src_layout.size, job.lod_bias).collect();
+                fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_dir_samples(src, src_layout, cubemap::texel_dir(face, x, y, s), &table));
+            } else {
+                fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(src, src_layout, face, x, y, s, r, n, job.lod_bias, e));
+            }
         }
         bar.finish_and_clear();
         Ok(texels)
@@ -136,7 +142,14 @@ impl Kernels for Cpu {
         let layout = CubeLayout::new(size, 1);
         let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
         let bar = progress("irradiance", (FACES * size) as u64);
-        fill_level(&mut texels, size, &bar, |face, x, y| irradiance::convolve_dir(src, src_layout, level, cubemap::texel_dir(face, x, y, size)));
+        // The summed level alone, as a one-level cube, followed by its geometry table (as
+        // the GPU backend does).
+        let s = src_layout.level_size(level);
+        let n = FACES * s * s;
+        let start = src_layout.level_offset(level) as usize;
+        let input: Vec<Vec4> = src[start..start + n as usize].iter().copied().chain(cubemap::level_geometry(s)).collect();
+        let one = CubeLayout::new(s, 1);
+        fill_level(&mut texels, size, &bar, |face, x, y| irradiance::convolve_dir(&input, one, 0, n, cubemap::texel_dir(face, x, y, size)));
         bar.finish_and_clear();
         Ok(texels)
     }

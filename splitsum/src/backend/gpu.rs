@@ -15,7 +15,7 @@ use crate::error::{Error, Result};
 use crate::texture::{Equirect, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::choice::Choice;
-use splitsum_shaders::cubemap::{CubeLayout, FACES};
+use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
 use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
@@ -761,11 +761,15 @@ impl Kernels for Gpu {
                 continue;
             }
             // An exact sum runs over every texel of its source level, in chunks.
-            let terms = if exact_level == prefilter::SAMPLED { samples } else { FACES * src_layout.level_size(exact_level).pow(2) };
+            let (terms, kernel) = if exact_level == prefilter::SAMPLED {
+                (samples, &spirv::KERNELS_PREFILTER_SPECULAR)
+            } else {
+                (FACES * src_layout.level_size(exact_level).pow(2), &spirv::KERNELS_PREFILTER_EXACT)
+            };
             for (start, count) in chunks(terms) {
                 let p = PrefilterParams { start, count, ..p };
                 self.run(&[Dispatch {
-                    kernel: &spirv::KERNELS_PREFILTER_SPECULAR,
+                    kernel,
                     params: bytemuck::bytes_of(&p),
                     input: Some(&src.buffer),
                     output: &accum,
@@ -785,12 +789,20 @@ impl Kernels for Gpu {
         }
         let accum = self.output("irradiance sums", 3 * bytes(layout.texel_count() as u64))?;
         let s = src_layout.level_size(level);
-        for (start, count) in chunks(FACES * s * s) {
-            let p = IrradianceParams { src_size: src_layout.size, src_levels: src_layout.levels, src_level: level, dst_size: size, start, count };
+        // The summed level alone, as a one-level cube, followed by its geometry table.
+        let n = FACES * s * s;
+        let input = self.output("irradiance input", 2 * bytes(n as u64))?;
+        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        encoder.copy_buffer_to_buffer(&src.buffer, bytes(src_layout.level_offset(level) as u64), &input, 0, bytes(n as u64));
+        self.queue.submit([encoder.finish()]);
+        let geometry: Vec<Vec4> = cubemap::level_geometry(s).collect();
+        self.queue.write_buffer(&input, bytes(n as u64), bytemuck::cast_slice(&geometry));
+        for (start, count) in chunks(n) {
+            let p = IrradianceParams { src_size: s, src_levels: 1, src_level: 0, dst_size: size, start, count, geometry: n };
             self.run(&[Dispatch {
                 kernel: &spirv::KERNELS_IRRADIANCE_CUBE,
                 params: bytemuck::bytes_of(&p),
-                input: Some(&src.buffer),
+                input: Some(&input),
                 output: &accum,
                 invocations: [size, size, FACES],
             }]);
@@ -807,7 +819,7 @@ impl Kernels for Gpu {
         let s = src_layout.level_size(level);
         let n = FACES * s * (SH9 as u32 + 1);
         let dst = self.texels("sh9 rows", n)?;
-        let p = IrradianceParams { src_size: src_layout.size, src_levels: src_layout.levels, src_level: level, dst_size: 0, start: 0, count: 0 };
+        let p = IrradianceParams { src_size: src_layout.size, src_levels: src_layout.levels, src_level: level, dst_size: 0, start: 0, count: 0, geometry: cubemap::INLINE_GEOMETRY };
         self.run(&[Dispatch {
             kernel: &spirv::KERNELS_IRRADIANCE_SH9_PROJECT,
             params: bytemuck::bytes_of(&p),
