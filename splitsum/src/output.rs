@@ -185,58 +185,81 @@ pub fn write_into(dir: &Path, name: &str, baked: &Baked, job: &Job, about: About
         manifest.files = engine_files(dir, name, baked, job)?;
         return write_manifest(dir, manifest);
     }
-    let mut files_out = Vec::new();
-    let mut add = |name: &str, what: String, written: Option<ktx2::Written>| {
-        files_out.push(OutputFile { name: name.to_string(), what, written });
-    };
+    // Each file is a job of its own, run on every core at once; the manifest lists them
+    // in this order.
+    type Job<'a> = Box<dyn FnOnce() -> Result<Vec<OutputFile>> + Send + 'a>;
+    let mut jobs: Vec<Job<'_>> = Vec::new();
+    let file = |name: &str, what: String, written: Option<ktx2::Written>| OutputFile { name: name.to_string(), what, written };
     // Previews at the source's exposure (the specular cube's mip 0 where no source was kept).
     let sky = baked.source.as_ref().or(baked.specular.as_ref());
     let exposure = sky.map_or(1.0, preview::auto_exposure);
-    let save_png = |name: &str, pic: &preview::Picture| -> Result<()> {
+    let save_png = move |name: &str, pic: &preview::Picture| -> Result<()> {
         files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
     };
     if let Some(source) = &baked.source {
-        save_png("preview_source.png", &preview::cross(source, 0, job.source_size.min(256)))?;
-        add("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None);
+        jobs.push(Box::new(move || {
+            save_png("preview_source.png", &preview::cross(source, 0, job.source_size.min(256)))?;
+            Ok(vec![file("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None)])
+        }));
     }
     if let Some(spec) = &baked.specular {
-        let w = ktx2::write(&dir.join("specular.ktx2"), spec, job.format)?;
-        report_clamp("specular.ktx2", &w);
-        add("specular.ktx2", "GGX-prefiltered radiance, one roughness per mip (roughness_per_mip)".into(), Some(w));
+        jobs.push(Box::new(move || {
+            let w = ktx2::write(&dir.join("specular.ktx2"), spec, job.format)?;
+            report_clamp("specular.ktx2", &w);
+            Ok(vec![file("specular.ktx2", "GGX-prefiltered radiance, one roughness per mip (roughness_per_mip)".into(), Some(w))])
+        }));
         for m in 0..spec.layout.levels {
-            let name = format!("specular_mip{m}.exr");
-            files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip[m as usize]))?;
-            add(&name, format!("mip {m} as EXR for inspection"), None);
+            jobs.push(Box::new(move || {
+                let name = format!("specular_mip{m}.exr");
+                files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip[m as usize]))?;
+                Ok(vec![file(&name, format!("mip {m} as EXR for inspection"), None)])
+            }));
         }
-        save_png("preview_specular.png", &preview::mip_strip(spec, 64))?;
-        add("preview_specular.png", "every specular mip as a cross, roughness rising to the right".into(), None);
+        jobs.push(Box::new(move || {
+            save_png("preview_specular.png", &preview::mip_strip(spec, 64))?;
+            Ok(vec![file("preview_specular.png", "every specular mip as a cross, roughness rising to the right".into(), None)])
+        }));
     }
     if let Some(irr) = &baked.irradiance {
-        let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, job.format)?;
-        report_clamp("irradiance.ktx2", &w);
-        add("irradiance.ktx2", "irradiance divided by π (cosine-weighted mean radiance)".into(), Some(w));
-        files::write_cube_level_exr(&dir.join("irradiance.exr"), irr, 0, "irradiance / pi")?;
-        add("irradiance.exr", "the irradiance cube as EXR for inspection".into(), None);
-        save_png("preview_irradiance.png", &preview::cross(irr, 0, 64))?;
-        add("preview_irradiance.png", "the irradiance cube as a cross".into(), None);
+        jobs.push(Box::new(move || {
+            let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, job.format)?;
+            report_clamp("irradiance.ktx2", &w);
+            files::write_cube_level_exr(&dir.join("irradiance.exr"), irr, 0, "irradiance / pi")?;
+            save_png("preview_irradiance.png", &preview::cross(irr, 0, 64))?;
+            Ok(vec![
+                file("irradiance.ktx2", "irradiance divided by π (cosine-weighted mean radiance)".into(), Some(w)),
+                file("irradiance.exr", "the irradiance cube as EXR for inspection".into(), None),
+                file("preview_irradiance.png", "the irradiance cube as a cross".into(), None),
+            ])
+        }));
     }
     if let Some(sh) = &baked.sh9 {
-        let file = ShFile {
-            convention: "real SH (Sloan 2008), radiance L_lm = sum L Y_lm dOmega; E(n)/pi = sum (A_l/pi) L_lm Y_lm(n), A_l/pi = 1, 2/3, 1/4",
-            order: ["0,0", "1,-1", "1,0", "1,1", "2,-2", "2,-1", "2,0", "2,1", "2,2"],
-            radiance: sh.radiance,
-            irradiance_over_pi: std::array::from_fn(|k| sh.radiance[k].map(|v| v * SH9_COSINE[k] as f64)),
-        };
-        let json = serde_json::to_string_pretty(&file).expect("serialisable");
-        files::write_atomic(&dir.join("sh9.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
-        add("sh9.json", format!("{SH9} spherical-harmonic coefficients of radiance and of E/π"), None);
+        jobs.push(Box::new(move || {
+            let file_contents = ShFile {
+                convention: "real SH (Sloan 2008), radiance L_lm = sum L Y_lm dOmega; E(n)/pi = sum (A_l/pi) L_lm Y_lm(n), A_l/pi = 1, 2/3, 1/4",
+                order: ["0,0", "1,-1", "1,0", "1,1", "2,-2", "2,-1", "2,0", "2,1", "2,2"],
+                radiance: sh.radiance,
+                irradiance_over_pi: std::array::from_fn(|k| sh.radiance[k].map(|v| v * SH9_COSINE[k] as f64)),
+            };
+            let json = serde_json::to_string_pretty(&file_contents).expect("serialisable");
+            files::write_atomic(&dir.join("sh9.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+            Ok(vec![file("sh9.json", format!("{SH9} spherical-harmonic coefficients of radiance and of E/π"), None)])
+        }));
     }
     if let Some(lut) = &baked.lut {
-        files::write_lut_exr(&dir.join("brdf_lut.exr"), lut)?;
-        files::write_png(&dir.join("brdf_lut.png"), lut.size, lut.size, &files::lut_preview(lut))?;
-        add("brdf_lut.exr", "split-sum BRDF table: R = scale, G = bias; x = n·v, y = roughness".into(), None);
-        add("brdf_lut.png", "its 8-bit preview".into(), None);
+        jobs.push(Box::new(move || {
+            files::write_lut_exr(&dir.join("brdf_lut.exr"), lut)?;
+            files::write_png(&dir.join("brdf_lut.png"), lut.size, lut.size, &files::lut_preview(lut))?;
+            Ok(vec![
+                file("brdf_lut.exr", "split-sum BRDF table: R = scale, G = bias; x = n·v, y = roughness".into(), None),
+                file("brdf_lut.png", "its 8-bit preview".into(), None),
+            ])
+        }));
     }
+    let files_out: Vec<OutputFile> = {
+        use rayon::prelude::*;
+        jobs.into_par_iter().map(|j| j()).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect()
+    };
     manifest.files = files_out;
     if let (Some(sh), Some(irr)) = (&baked.sh9, &baked.irradiance) {
         manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));

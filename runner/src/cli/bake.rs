@@ -58,8 +58,14 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let source_size = settings.resolve(InputShape::Unknown, products)?.source_size;
     refuse_unread(given, &settings, products, env_path.is_dir())?;
     let out = files::OutputDir::begin(&args.out, "--out")?;
-    let (env, input) = load_input(&env_path, args.sanitize, source_size)?;
-    let backend = Backend::open(args.backend)?;
+    // The device starts (its pipelines built) while the input is read.
+    let (read, backend) = std::thread::scope(|s| {
+        let opening = s.spawn(|| Backend::open(args.backend));
+        let read = load_input(&env_path, args.sanitize, source_size);
+        (read, opening.join().expect("opening the backend panicked"))
+    });
+    let (env, input) = read?;
+    let backend = backend?;
     if let Some(budget) = args.budget {
         settings = within_budget(&settings, InputShape::of(&env), products, budget, &backend, given)?;
     }

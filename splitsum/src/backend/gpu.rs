@@ -225,17 +225,40 @@ impl Gpu {
         if let Some(e) = scope.pop().await {
             return Err(Error::Gpu(format!("the shader module did not validate on {}: {e}", info.name)));
         }
-        // One pipeline at a time, each checked before the next: an error names its kernel.
-        let mut pipelines = HashMap::new();
-        // The cube reader binds a texture of the caller's format: built when needed.
-        for k in splitsum_spirv::KERNELS.iter().filter(|k| k.name != spirv::KERNELS_READ_CUBE.name) {
+        // Each pipeline checked in an error scope of its own, so that an error names its
+        // kernel. The cube reader binds a texture of the caller's format: built when needed.
+        let kernels: Vec<&EntryPoint> = splitsum_spirv::KERNELS.iter().filter(|k| k.name != spirv::KERNELS_READ_CUBE.name).collect();
+        let build = |k: &EntryPoint| {
             let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
             let pipeline = kernel_pipeline(device, &module, k, &layout);
-            if let Some(e) = scope.pop().await {
-                return Err(Error::Gpu(format!("kernel {} did not validate on {}: {e}", k.name, info.name)));
+            (pipeline, layout, scope)
+        };
+        let mut pipelines = HashMap::new();
+        // Natively the pipelines are built on every core at once (the driver compiles each;
+        // error scopes are per thread); in a browser, one after another.
+        #[cfg(not(target_arch = "wasm32"))]
+        let built: Vec<_> = {
+            use rayon::prelude::*;
+            kernels.par_iter().map(|k| {
+                let (pipeline, layout, scope) = build(k);
+                (k.name, pipeline, layout, pollster::block_on(scope.pop()))
+            }).collect()
+        };
+        #[cfg(target_arch = "wasm32")]
+        let built: Vec<_> = {
+            let mut built = Vec::new();
+            for k in &kernels {
+                let (pipeline, layout, scope) = build(k);
+                built.push((k.name, pipeline, layout, scope.pop().await));
             }
-            pipelines.insert(k.name, (pipeline, layout));
+            built
+        };
+        for (name, pipeline, layout, error) in built {
+            if let Some(e) = error {
+                return Err(Error::Gpu(format!("kernel {name} did not validate on {}: {e}", info.name)));
+            }
+            pipelines.insert(name, (pipeline, layout));
         }
         let empty = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("empty input"),
