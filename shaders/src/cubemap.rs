@@ -205,13 +205,45 @@ pub fn texel_of_dir(layout: CubeLayout, level: u32, d: Vec3) -> u32 {
 #[inline]
 fn tap_index(layout: CubeLayout, level: u32, face: u32, x: i32, y: i32, s: u32) -> u32 {
     let si = s as i32;
-    if x >= 0 && x < si && y >= 0 && y < si {
-        layout.index(level, face, x as u32, y as u32)
-    } else {
-        let sf = s as f32;
-        let uv = Vec2::new((x as f32 + 0.5) / sf, (y as f32 + 0.5) / sf);
-        texel_of_dir(layout, level, face_uv_to_cube(face, uv))
+    let inside = x >= 0 && x < si && y >= 0 && y < si;
+    // Natively, most taps are inside and skip the wrap. On the GPU there is no branch on
+    // the way: llvmpipe runs both sides of a branch whenever any lane takes either, and
+    // the geometric wrap this table replaced cost a third of the prefilter there.
+    #[cfg(not(target_arch = "spirv"))]
+    if inside {
+        return layout.index(level, face, x as u32, y as u32);
     }
+    // Off the face in one axis: the edge crossed and the coordinate along it.
+    let edge = if x < 0 { 0 } else if x >= si { 1 } else if y < 0 { 2 } else { 3 };
+    let t = (if edge < 2 { y } else { x }) as u32;
+    let (f, ex, ey) = edge_texel(face, edge, t, s);
+    if inside { layout.index(level, face, x as u32, y as u32) } else { layout.index(level, f, ex, ey) }
+}
+
+/// Where the texel one step across edge `edge` (0: x = −1, 1: x = s, 2: y = −1, 3: y = s) of
+/// `face`, at coordinate `t` along that edge, lies on the neighbouring face of an `s`-wide
+/// level: `(face, x, y)`. This is the texel whose square holds the direction through that
+/// texel's centre on the extended face plane, which is what a seamless lookup reads
+/// (`texel_of_dir(face_uv_to_cube(face, uv))`): projected onto the neighbour, its
+/// along-edge coordinate `(t + 1)/(s + 1)` of the face lies strictly inside texel `t` (or
+/// `s − 1 − t`), and its across-edge one inside the edge texel, so the wrap is a
+/// permutation of texels, tabulated here per face as four 7-bit entries (neighbour face;
+/// x and y as 0: 0, 1: s − 1, 2: t, 3: s − 1 − t). `shaders/tests/cubemap.rs` checks every
+/// entry against the geometric lookup at every size up to 1024.
+#[inline]
+pub fn edge_texel(face: u32, edge: u32, t: u32, s: u32) -> (u32, u32, u32) {
+    let word: u32 = match face {
+        0 => 0x097a_a2cc,
+        1 => 0x0c70_a24d,
+        2 => 0x0287_4c11,
+        3 => 0x07ad_1839,
+        4 => 0x026c_a049,
+        _ => 0x0766_a0c8,
+    };
+    let entry = (word >> (7 * edge)) & 127;
+    let last = s.wrapping_sub(1);
+    let pick = |code: u32| if code == 0 { 0 } else if code == 1 { last } else if code == 2 { t } else { last.wrapping_sub(t) };
+    (entry & 7, pick((entry >> 3) & 3), pick((entry >> 5) & 3))
 }
 
 /// One weighted bilinear tap: the texel's value times `w`, and `w`; nothing for a tap off

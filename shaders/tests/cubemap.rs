@@ -235,3 +235,34 @@ fn log_luminance_mip_blend_is_geometric_between_levels() {
     let got = cubemap::sample_lod_log(&black, layout, d, 0.5);
     assert!(got.is_finite() && got.truncate().max_element() < 1e-3, "{got}");
 }
+
+/// The tabulated edge wrap (`cubemap::edge_texel`) is the geometric one: for every face,
+/// every edge, every texel along it and every level size from 1 to 1024, the texel one
+/// step across the edge is the texel whose square holds the direction through that step's
+/// centre on the extended face plane (`texel_of_dir(face_uv_to_cube(face, uv))`, in the
+/// same f32 arithmetic the seamless lookup used before the table).
+#[test]
+fn the_tabulated_edge_wrap_is_the_geometric_one() {
+    let mut s = 1u32;
+    while s <= 1024 {
+        let layout = CubeLayout::new(s, 1);
+        for face in 0..6 {
+            for edge in 0..4u32 {
+                for t in 0..s {
+                    let (x, y) = match edge {
+                        0 => (-1, t as i32),
+                        1 => (s as i32, t as i32),
+                        2 => (t as i32, -1),
+                        _ => (t as i32, s as i32),
+                    };
+                    let sf = s as f32;
+                    let uv = Vec2::new((x as f32 + 0.5) / sf, (y as f32 + 0.5) / sf);
+                    let want = cubemap::texel_of_dir(layout, 0, cubemap::face_uv_to_cube(face, uv));
+                    let (f, ex, ey) = cubemap::edge_texel(face, edge, t, s);
+                    assert_eq!(layout.index(0, f, ex, ey), want, "size {s}, face {face}, edge {edge}, t {t}");
+                }
+            }
+        }
+        s *= 2;
+    }
+}
