@@ -202,7 +202,7 @@ pub fn texel_of_dir(layout: CubeLayout, level: u32, d: Vec3) -> u32 {
 
 /// Index of the texel that tap `(x, y)` of `face` reads, where `x` or `y` may be one texel
 /// off the face: such a tap is re-projected onto the neighbouring face.
-#[inline]
+#[inline(always)]
 fn tap_index(layout: CubeLayout, level: u32, face: u32, x: i32, y: i32, s: u32) -> u32 {
     let si = s as i32;
     let inside = x >= 0 && x < si && y >= 0 && y < si;
@@ -248,7 +248,7 @@ pub fn edge_texel(face: u32, edge: u32, t: u32, s: u32) -> (u32, u32, u32) {
 
 /// One weighted bilinear tap: the texel's value times `w`, and `w`; nothing for a tap off
 /// the face in both axes.
-#[inline]
+#[inline(always)]
 fn tap(texels: &[Vec4], layout: CubeLayout, level: u32, face: u32, s: u32, x: i32, y: i32, w: f32) -> (Vec4, f32) {
     let si = s as i32;
     let x_in = x >= 0 && x < si;

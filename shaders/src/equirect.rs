@@ -135,9 +135,14 @@ fn row_mean(pyramid: &[Vec4], width: u32, height: u32, level: u32, y: u32, a: f3
         let lo = math::max(k as f32, a);
         let hi = math::min(k as f32 + 1.0, end);
         if hi > lo {
-            let mut x = k % w;
+            // k mod w without a division (no vector integer division on a CPU driver):
+            // a ∈ [−w/2, w) and len ≤ w put k in [−w, 2w).
+            let mut x = k;
             if x < 0 {
                 x += w;
+            }
+            if x >= w {
+                x -= w;
             }
             // Weights normalised as they go: the mean never exceeds the largest texel.
             acc += pyramid[(row + x as u32) as usize] * ((hi - lo) / len);

@@ -379,7 +379,7 @@ impl Machine {
 
 /// Runs the calibration kernel on `backend` and returns its rates: each kind of work on a
 /// 128² cube with its mip chain (values from a fixed hash, positive and finite), timed
-/// after a first run that warms the pipeline and caches; the faster of two runs is kept.
+/// after a first run that warms the pipeline and caches; the fastest of four runs is kept.
 pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Result<Machine> {
     use crate::backend::{Backend, Kernels};
     use splitsum_shaders::calibrate::Rate;
@@ -395,7 +395,7 @@ pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Resul
             .collect();
         let src = k.upload("calibration cube", &texels)?;
         let mut best = f64::INFINITY;
-        for run in 0..3 {
+        for run in 0..5 {
             k.finish()?;
             let t = web_time::Instant::now();
             let out = k.calibrate(&src, layout, rate, size, count)?;
