@@ -51,11 +51,13 @@ impl Default for Calibration {
                 (0.875, vec![(16, 0.0383), (64, 0.0353), (256, 0.0269)]),
             ],
             irradiance: vec![(4, 0.035), (8, 0.0181), (16, 0.0067), (32, 0.00168), (64, 0.00083)],
-            // Rates from `runner bench` of the defaults on city.exr: 12.2 M prefilter samples in
-            // 0.51 s / 0.82 s, 36 M table evaluations (quadrature) in 0.12 s / 0.33 s, 9.4 M
-            // irradiance texel pairs in 0.077 s / 0.156 s. An SH9 texel (nine basis
-            // functions, one weighted add each) is taken at an irradiance pair's rate.
-            ns: Rates([(139.0, 46.0), (41.5, 67.0), (8.2, 16.5), (8.2, 16.5), (3.3, 9.1)]),
+            // Rates from `runner bench` of the defaults on city.exr (December 2026): 3.5 M
+            // equirect supersamples in 0.10 s / 0.10 s, 12.2 M prefilter samples in 0.31 s /
+            // 0.32 s, 9.4 M irradiance texel pairs in 0.035 s / 0.010 s. An SH9 texel (nine
+            // basis functions, one weighted add each) is taken at an irradiance pair's rate.
+            // A table other than the embedded one is integrated once per process on the CPU
+            // (`crate::table`), 36 M evaluations in 0.33 s, whichever backend bakes.
+            ns: Rates([(28.0, 29.0), (25.0, 26.0), (3.7, 1.1), (3.7, 1.1), (9.1, 9.1)]),
         }
     }
 }
@@ -209,7 +211,9 @@ fn work(job: &Job) -> (PerStep, u64) {
         }
     }
     if job.products.lut {
+        // The embedded table is uploaded, not integrated (`crate::table`).
         let per_texel = match job.lut_method {
+            _ if crate::table::TableKey::of(job) == crate::table::TableKey::EMBEDDED => 0,
             TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
             TableMethod::Sampled => job.lut_samples,
         };
@@ -416,11 +420,11 @@ pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Resul
     }
 }
 
-/// The share of its limit a step reaches, for turning the cost model's limits into a time
-/// estimate on a device measured only by the calibration kernel: the lowest of the steps
-/// that dominate a bake on lavapipe and on 2 CPU cores (`runner bench` of the defaults on
-/// city.exr: source cube 40–74 %, specular 59–83 %, irradiance 34–46 %).
-pub const SHARE_OF_LIMIT: f64 = 0.4;
+/// The share of its limits a bake reaches, for turning the cost model's limits into a time
+/// estimate on a device measured only by the calibration kernel: a little under what the
+/// default bake of city.exr reaches as a whole (`runner bench`, December 2026: the sum of
+/// its steps' limits over its time, 0.66 on lavapipe and 0.69 on 2 CPU cores).
+pub const SHARE_OF_LIMIT: f64 = 0.6;
 
 /// The settings a bake within `budget` seconds on `machine` should use: among the
 /// specular sample counts and irradiance source sizes the error model `cal` measured, the
