@@ -50,6 +50,21 @@ fn quick_report_writes_tables_csv_and_plot() {
             assert!(rows.iter().any(|r| r.product == Product::ShadedColour && r.method == method && r.fetches == Some(fetches) && r.backend == backend));
         }
     }
+    // The budget curve: every budget on both backends, each choice's estimate within its
+    // budget unless it is the cheapest there is; its figure and table on the page.
+    for backend in ["gpu", "cpu"] {
+        let chosen: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.method == Method::TimeBudget && r.product == Product::ShadedColour && r.backend == backend && r.part == Part::Total && r.roughness_lo.is_none() && r.nv_hi.is_none())
+            .filter_map(|r| Some((r.budget_s?, r.estimate_s?)))
+            .collect();
+        assert_eq!(chosen.len(), splitsum_report::accuracy::BUDGETS.len(), "{backend}: {chosen:?}");
+        let cheapest = chosen.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+        assert!(chosen.iter().all(|&(b, e)| e <= b || e == cheapest), "{backend}: {chosen:?}");
+    }
+    let budget = std::fs::read_to_string(dir.join("budget.svg")).unwrap();
+    assert!(budget.starts_with("<svg") && budget.contains("budget per bake (s)"));
+    assert!(md.contains("## time budget") && html.contains("budget.svg"));
     let ladder = std::fs::read_to_string(dir.join("ladder.svg")).unwrap();
     assert!(ladder.starts_with("<svg") && ladder.contains("ns per shaded pixel"));
     assert!(md.contains("## shading ladder") && html.contains("ladder.svg"));

@@ -376,3 +376,40 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
     }
     Ok(rows)
 }
+
+/// The time budgets per bake (seconds) of the report's budget-to-error curve.
+pub const BUDGETS: [f64; 6] = [0.1, 0.2, 0.3, 0.5, 1.0, 2.0];
+
+/// The budget-to-error curve on `backend`: for each budget, the settings
+/// `splitsum::cost::for_budget` chooses from `base` (on this backend's limits, measured by
+/// the calibration kernel first), baked, timed and measured at `points` with `base`'s
+/// shading, as [`measure`] does; the rows carry the budget and the estimate. Budgets that
+/// choose the same settings share one bake.
+pub fn budget_rows(backend: &Backend, env: &Environment, base: &Method, points: &Points) -> Result<Vec<Measurement>> {
+    let machine = splitsum::cost::measure_machine(backend)?;
+    let shape = splitsum::InputShape::of(env);
+    let calibration = splitsum::cost::Calibration::default();
+    let mut rows = Vec::new();
+    let mut done: Vec<(Settings, Vec<Measurement>)> = Vec::new();
+    for budget in BUDGETS {
+        let (settings, _, estimate) = splitsum::cost::for_budget(&base.settings, shape, splitsum::Products::DISPLAY, budget, &machine, &calibration)?;
+        let measured = match done.iter().find(|(s, _)| *s == settings) {
+            Some((_, r)) => r.clone(),
+            None => {
+                let method = Method { kind: Kind::TimeBudget, settings: settings.clone(), flags: base.flags };
+                let r = measure(backend, env, &[method], points)?;
+                done.push((settings.clone(), r.clone()));
+                r
+            }
+        };
+        let irradiance_source = settings.resolve(shape, splitsum::Products::DISPLAY)?.irradiance_source;
+        rows.extend(measured.into_iter().map(|r| Measurement {
+            knob: Knob::Budget,
+            budget_s: Some(budget),
+            estimate_s: Some(estimate),
+            source_size: Some(irradiance_source),
+            ..r
+        }));
+    }
+    Ok(rows)
+}

@@ -48,6 +48,7 @@ pub fn method_colour(m: Method) -> RGBColor {
         Method::FilamentLookup => RGBColor(0, 120, 120),
         Method::Sh9 => RGBColor(120, 94, 240),
         Method::ExactIngredients => RGBColor(90, 90, 90),
+        Method::TimeBudget => RGBColor(0, 60, 140),
     }
 }
 
@@ -185,12 +186,15 @@ pub struct LadderCurve {
 pub struct LadderPanel {
     /// Which backend's costs.
     pub title: String,
+    /// What the horizontal axis (logarithmic) measures.
+    pub x_label: String,
     /// Its curves.
     pub curves: Vec<LadderCurve>,
 }
 
-/// The shading ladder's figure as an SVG document: error against ns per shaded pixel, a
-/// panel per backend, each rung's point labelled with its fetches.
+/// Error against a cost as an SVG document (the shading ladder's against ns per shaded
+/// pixel, each rung's point labelled with its fetches; the budget curve's against the
+/// budget, labelled with the samples chosen): a panel per backend.
 pub fn ladder(panels: &[LadderPanel]) -> Result<String, Error> {
     const PALETTE: [RGBColor; 5] = [RGBColor(0, 114, 178), RGBColor(86, 180, 233), RGBColor(0, 158, 115), RGBColor(213, 94, 0), RGBColor(230, 159, 0)];
     let (panel_w, panel_h) = (460u32, 340u32);
@@ -211,7 +215,7 @@ pub fn ladder(panels: &[LadderPanel]) -> Result<String, Error> {
                 .build_cartesian_2d(xr.log_scale(), 0.0..top)?;
             chart
                 .configure_mesh()
-                .x_desc("ns per shaded pixel")
+                .x_desc(panel.x_label.as_str())
                 .y_desc("mean relative error")
                 .x_label_formatter(&|v| sci(*v))
                 .y_label_formatter(&|v| format!("{:.0} %", 100.0 * v))

@@ -282,6 +282,12 @@ pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, s
         let _step = splitsum::progress::step(&format!("report: end to end on {}", backend.describe()), None);
         rows.extend(crate::accuracy::measure(backend, env, &methods, &points)?);
     }
+    // The budget-to-error curve: the settings chosen for each time budget, measured the same way.
+    let base = methods.iter().find(|m| m.kind == Method::Defaults && m.settings.samples == Settings::default().samples).unwrap_or(&methods[0]);
+    for backend in backends {
+        let _step = splitsum::progress::step(&format!("report: time budgets on {}", backend.describe()), None);
+        rows.extend(crate::accuracy::budget_rows(backend, env, base, &points)?);
+    }
     if let Some(sets) = sets {
         let keep = |m: &crate::sets::Member| {
             sets.only.is_none_or(|s| s == m.set)
@@ -733,6 +739,8 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
 }
 
 /// What the shading ladder is, in the report.
+const BUDGET_NOTE: &str = "For each time budget per bake, the settings splitsum::cost::for_budget chooses on this backend (the cost model's limits measured by the calibration kernel, the built-in error model): the sample count at mip 1 and the irradiance source. Each is baked, timed (the bake as run here, not the estimate) and measured end to end like the methods below: shaded colour against the full reflectance integral over this environment's points.";
+
 const LADDER_NOTE: &str = "The shading ladder: the split sum's one prefiltered fetch, then 2 to 16 fetches of filtered importance sampling of the true GGX lobe over the prefiltered mips (shade::lobe_radiance), used below n·v 0.7. Shaded colour against the full reflectance integral (mean relative luminance error, the largest point in brackets), against what a shaded pixel costs: ns per pixel of a sphere in the default view, direct lights included (a frame with the spheres less one without, best of three).";
 
 /// The method of the ladder's rung with `fetches`: the defaults' one fetch, the ladder above.
@@ -841,7 +849,72 @@ pub fn ladder_panels(rows: &[Measurement]) -> Vec<crate::plot::LadderPanel> {
                 curves.push(crate::plot::LadderCurve { label: label.to_string(), points });
             }
         }
-        panels.push(crate::plot::LadderPanel { title: format!("shading ladder, cost on the {}", if engine == "gpu" { "GPU" } else { "CPU" }), curves });
+        panels.push(crate::plot::LadderPanel {
+            title: format!("shading ladder, cost on the {}", if engine == "gpu" { "GPU" } else { "CPU" }),
+            x_label: "ns per shaded pixel".into(),
+            curves,
+        });
+    }
+    panels
+}
+
+/// The budget curve's rows: the shaded colour's total over all points of the report's
+/// environment (or its `n·v ≤ 0.1` band), per backend and budget.
+fn budget_rows(rows: &[Measurement], band: Option<f32>) -> impl Iterator<Item = &Measurement> {
+    rows.iter().filter(move |r| {
+        r.method == Method::TimeBudget
+            && r.product == Product::ShadedColour
+            && r.part == Part::Total
+            && r.set.is_none()
+            && r.roughness_lo.is_none()
+            && r.near_sun.is_none()
+            && r.nv_hi == band
+    })
+}
+
+/// The budget curve's table: per backend and budget, the settings chosen, their estimated
+/// and measured bake time, and their error end to end.
+fn budget_table(rows: &[Measurement]) -> Option<Table> {
+    let cells: Vec<[String; 8]> = budget_rows(rows, None)
+        .map(|r| {
+            let grazing = budget_rows(rows, Some(0.1)).find(|g| g.backend == r.backend && g.budget_s == r.budget_s).map_or("-".into(), |g| format!("{:.1} %", 100.0 * g.mean_error));
+            [
+                r.backend.clone(),
+                format!("{}", r.budget_s.unwrap_or(f64::NAN)),
+                r.samples.map_or("-".into(), |n| n.to_string()),
+                r.source_size.map_or("-".into(), |s| format!("{s}²")),
+                r.estimate_s.map_or("-".into(), |e| format!("{e:.3}")),
+                r.time_ms.map_or("-".into(), |t| format!("{:.3}", t * 1e-3)),
+                format!("{:.1} %", 100.0 * r.mean_error),
+                grazing,
+            ]
+        })
+        .collect();
+    (!cells.is_empty()).then(|| {
+        let header = ["backend", "budget (s)", "samples at mip 1", "irradiance from", "estimate (s)", "bake (s)", "error, this environment", "its n·v ≤ 0.1"];
+        ("time budget: the settings chosen and their error".to_string(), header, cells)
+    })
+}
+
+/// The budget curve's figure: the error end to end against the budget, a panel per backend.
+pub fn budget_panels(rows: &[Measurement]) -> Vec<crate::plot::LadderPanel> {
+    let mut panels = Vec::new();
+    for engine in ["gpu", "cpu"] {
+        let curve = |band: Option<f32>| -> Vec<(f64, f64, u32)> {
+            budget_rows(rows, band).filter(|r| r.backend == engine).filter_map(|r| Some((r.budget_s?, r.mean_error, r.samples?))).collect()
+        };
+        let curves: Vec<crate::plot::LadderCurve> = [("this environment", None), ("its n·v ≤ 0.1", Some(0.1))]
+            .into_iter()
+            .map(|(label, band)| crate::plot::LadderCurve { label: label.to_string(), points: curve(band) })
+            .filter(|c| !c.points.is_empty())
+            .collect();
+        if !curves.is_empty() {
+            panels.push(crate::plot::LadderPanel {
+                title: format!("time budget on the {}", if engine == "gpu" { "GPU" } else { "CPU" }),
+                x_label: "budget per bake (s)".into(),
+                curves,
+            });
+        }
     }
     panels
 }
@@ -866,6 +939,10 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
     let ladder = ladder_table(rows);
     if ladder.is_some() {
         files::write_atomic(&dir.join("ladder.svg"), |w| svg(w, crate::plot::ladder(&ladder_panels(rows))))?;
+    }
+    let budget = budget_table(rows);
+    if budget.is_some() {
+        files::write_atomic(&dir.join("budget.svg"), |w| svg(w, crate::plot::ladder(&budget_panels(rows))))?;
     }
     files::write_atomic(&dir.join("surface_scale.svg"), |w| {
         svg(w, crate::plot::colour_scale("relative luminance error", crate::surface::false_colour, &crate::surface::scale_ticks()))
@@ -897,6 +974,12 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
     let _ = writeln!(md, "\n![scale](surface_scale.svg)");
     if let Some((title, header, cells)) = &ladder {
         let _ = writeln!(md, "\n## {title}\n\n{LADDER_NOTE}\n\n![the shading ladder](ladder.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
+        for c in cells {
+            let _ = writeln!(md, "| {} |", c.join(" | "));
+        }
+    }
+    if let Some((title, header, cells)) = &budget {
+        let _ = writeln!(md, "\n## {title}\n\n{BUDGET_NOTE}\n\n![the budget curve](budget.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
         for c in cells {
             let _ = writeln!(md, "| {} |", c.join(" | "));
         }
@@ -943,6 +1026,19 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
             "<h2 id=\"ladder\">{}</h2>\n<p>{}</p>\n<figure><img src=\"ladder.svg\" alt=\"error against ns per shaded pixel, one point per rung\"></figure>\n<table><tr>{}</tr>",
             html_escape(title),
             html_escape(LADDER_NOTE),
+            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
+        );
+        for c in cells {
+            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
+        }
+        let _ = writeln!(html, "</table>");
+    }
+    if let Some((title, header, cells)) = &budget {
+        let _ = writeln!(
+            html,
+            "<h2 id=\"budget\">{}</h2>\n<p>{}</p>\n<figure><img src=\"budget.svg\" alt=\"error against the time budget, one point per budget\"></figure>\n<table><tr>{}</tr>",
+            html_escape(title),
+            html_escape(BUDGET_NOTE),
             header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
         );
         for c in cells {

@@ -76,6 +76,9 @@ pub enum Method {
     Sh9,
     /// The split sum from exact ingredients: the error of the approximation itself.
     ExactIngredients,
+    /// The settings `cost::for_budget` chooses for a time budget (`budget_s`) on the
+    /// backend, and the default shading.
+    TimeBudget,
 }
 
 impl Method {
@@ -96,6 +99,7 @@ impl Method {
             Method::FilamentLookup => "filament target, engine's trilinear read",
             Method::Sh9 => "SH9",
             Method::ExactIngredients => "exact ingredients (split sum alone)",
+            Method::TimeBudget => "settings for a time budget",
         }
     }
 }
@@ -131,6 +135,8 @@ pub enum Knob {
     Quality,
     /// Prefiltered fetches per shaded pixel (`fetches`).
     Fetches,
+    /// A time budget per bake (`budget_s`).
+    Budget,
     /// Nothing: one measurement.
     None,
 }
@@ -201,6 +207,13 @@ pub struct Measurement {
     pub fetches: Option<u32>,
     /// Shading time per pixel in nanoseconds (the shading ladder, timed on a frame).
     pub ns_per_pixel: Option<f64>,
+    /// The time budget per bake in seconds the settings were chosen for
+    /// (`Method::TimeBudget`).
+    #[serde(default)]
+    pub budget_s: Option<f64>,
+    /// The estimated seconds of the settings chosen for `budget_s`.
+    #[serde(default)]
+    pub estimate_s: Option<f64>,
     /// Roughness band `[lo, hi)` of the points (or the level's roughness, `lo = hi`).
     pub roughness_lo: Option<f32>,
     /// Upper end of the roughness band.
@@ -243,6 +256,8 @@ impl Measurement {
             bias: None,
             fetches: None,
             ns_per_pixel: None,
+            budget_s: None,
+            estimate_s: None,
             roughness_lo: None,
             roughness_hi: None,
             nv_lo: None,
@@ -263,6 +278,7 @@ impl Measurement {
             Knob::Bias => self.bias.map(f64::from),
             Knob::SourceSize => self.source_size.map(f64::from),
             Knob::Fetches => self.fetches.map(f64::from),
+            Knob::Budget => self.budget_s,
             Knob::None => None,
         }
     }
@@ -281,6 +297,9 @@ impl Measurement {
         }
         if let Some(b) = self.bias {
             parts.push(format!("bias {b}"));
+        }
+        if let Some(b) = self.budget_s {
+            parts.push(format!("budget {b} s"));
         }
         match self.fetches {
             Some(1) => parts.push("1 fetch".into()),
