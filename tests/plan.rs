@@ -473,3 +473,32 @@ fn a_larger_budget_never_predicts_more_error() {
         last = error;
     }
 }
+
+/// `[quality] max_seconds`: the planner picks, over the roughness the scene reads, the
+/// measured settings with the lowest predicted error whose estimate (lavapipe's built-in
+/// rates, the levels the plan keeps) fits; a larger budget never predicts more error, the
+/// estimate of a choice that fits is within the budget, and the choice is stated. Beside a
+/// setting it would choose, or not a positive number, it is refused by the field's name.
+#[test]
+fn a_time_budget_picks_the_lowest_predicted_error_that_fits() {
+    let body = material("plastic", "roughness = [0.3, 1.0]");
+    let plan_for = |b: f64| planned(&scene("", &format!("{body}\n[quality]\nmax_seconds = {b}")));
+    let predicted = |p: &Plan| p.decisions.iter().find(|d| d.what == "time budget").map(|d| d.why.clone()).expect("the budget's decision is stated");
+    let mut last = f64::INFINITY;
+    for budget in [0.01, 0.2, 0.5, 1.0, 5.0] {
+        let p = plan_for(budget);
+        let why = predicted(&p);
+        let error: f64 = why.split("predicted error ").nth(1).and_then(|t| t.split(',').next()).and_then(|t| t.parse().ok()).expect("an error in the statement");
+        println!("budget {budget}: {} samples, irradiance {}: {why}", p.job.samples, p.job.irradiance_source);
+        assert!(error <= last + 1e-12, "budget {budget}: {error} above the smaller budget's {last}");
+        assert!(p.cost.gpu_seconds <= budget || why.contains("cheapest"), "budget {budget}: estimated {} s: {why}", p.cost.gpu_seconds);
+        last = error;
+    }
+    for (extra, field) in [("max_error = 0.1", "max_error"), ("samples = 64", "samples"), ("irradiance_source = 16", "irradiance_source")] {
+        let text = format!("environment = \"x.exr\"\n{body}\n[quality]\nmax_seconds = 0.5\n{extra}");
+        let e = Scene::parse(&text).expect_err("refused").to_string();
+        assert!(e.contains("max_seconds") && e.contains(field), "{e}");
+    }
+    let e = Scene::parse(&format!("environment = \"x.exr\"\n{body}\n[quality]\nmax_seconds = -1")).expect_err("refused").to_string();
+    assert!(e.contains("max_seconds") && e.contains("positive"), "{e}");
+}

@@ -14,6 +14,8 @@
 //!   be finer than a pixel, nor than half the narrowest lobe (`α = r²` radians), nor than
 //!   the environment itself;
 //! - SH9 is left out: the display reads the irradiance cube;
+//! - with `[quality] max_seconds`, the samples and the irradiance source with the lowest
+//!   predicted error over the roughness the scene reads whose estimate fits the budget;
 //! - with `[quality] max_error`, each product gets the cheapest measured setting whose mean
 //!   error meets it ([`Calibration`], from `runner report`); for the prefilter that error is
 //!   the end-to-end measure's: the share of the shaded colour's error the bake adds, in the
@@ -189,6 +191,21 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     }
     if needed_r.is_empty() {
         needed_r = levels.iter().map(|&l| roughness_of(l)).filter(|&r| r > 0.0).collect();
+    }
+    // A time budget: the lowest predicted error over the roughness the scene reads that fits
+    // (estimated on lavapipe's built-in rates, for the levels the plan keeps).
+    if let Some(budget) = q.max_seconds {
+        let products = Products { specular, irradiance, sh9: false, lut };
+        let seconds = |job: &splitsum::Job| job.clone().with_levels(levels.clone()).map_or(f64::INFINITY, |j| splitsum::cost::step_seconds(&j, cal, true).total());
+        let (chosen, error, estimate) = splitsum::cost::for_budget_by(&settings, shape, products, budget, cal, Some(&needed_r), seconds)?;
+        let fits = if estimate <= budget { "fits" } else { "is the cheapest measured, over" };
+        decide(
+            "time budget",
+            true,
+            format!("{} samples, irradiance from {}²: predicted error {error:.2e}, estimated {estimate:.2} s on lavapipe ({fits} {budget} s)", chosen.samples, chosen.irradiance_source.unwrap_or_default()),
+        );
+        settings.samples = chosen.samples;
+        settings.irradiance_source = chosen.irradiance_source;
     }
     settings.samples = match (q.samples, target) {
         (Some(n), _) => n,

@@ -17,6 +17,7 @@
 //!
 //! [quality]                                       # every field optional
 //! max_error = 0.02                                # mean error per product: the planner picks the cheapest settings
+//! # max_seconds = 0.3                             # or a time budget: the lowest predicted error that fits
 //! samples = 1024                                  # or fix them
 //!
 //! [[materials]]
@@ -347,6 +348,10 @@ pub struct QualitySpec {
     /// Largest acceptable mean error per product (relative for radiance, absolute for the
     /// table): the planner picks the cheapest measured settings that meet it.
     pub max_error: Option<f64>,
+    /// A time budget for the bake in seconds, on lavapipe's built-in rates
+    /// (`cost::Calibration`): the planner picks the measured settings (samples, irradiance
+    /// source) with the lowest predicted error over the roughness the scene reads that fit.
+    pub max_seconds: Option<f64>,
     /// GGX samples per specular texel.
     pub samples: Option<u32>,
     /// Source-mip bias.
@@ -476,6 +481,16 @@ impl Scene {
             && !(e > 0.0) {
                 return bad(format!("[quality] max_error must be positive, not {e}"));
             }
+        if let Some(b) = self.quality.max_seconds {
+            if !(b > 0.0 && b.is_finite()) {
+                return bad(format!("[quality] max_seconds must be a positive number of seconds, not {b}"));
+            }
+            for (set, field) in [(self.quality.max_error.is_some(), "max_error"), (self.quality.samples.is_some(), "samples"), (self.quality.irradiance_source.is_some(), "irradiance_source")] {
+                if set {
+                    return bad(format!("[quality] max_seconds chooses the settings itself: give it or {field}, not both"));
+                }
+            }
+        }
         // The [quality] fields that are bake settings go through the one validation,
         // `Settings::validate`, which names them as the scene does.
         let q = &self.quality;

@@ -426,19 +426,40 @@ pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Resul
 /// its steps' limits over its time, 0.66 on lavapipe and 0.69 on 2 CPU cores).
 pub const SHARE_OF_LIMIT: f64 = 0.6;
 
-/// The settings a bake within `budget` seconds on `machine` should use: among the
-/// specular sample counts and irradiance source sizes the error model `cal` measured, the
-/// pair with the lowest predicted error whose estimated time fits (the specular bake's
-/// share of the shaded colour's error, its mean over the calibrated roughness bands, plus
-/// the irradiance's error). Returns the settings, the predicted error and the estimated
-/// seconds; when nothing fits, the cheapest pair, whose estimate then exceeds `budget`.
+/// The settings a bake within `budget` seconds on `machine` should use: [`for_budget_by`]
+/// over every calibrated roughness band, each candidate's time estimated from the cost
+/// model's limits on `machine` at [`SHARE_OF_LIMIT`].
 pub fn for_budget(given: &crate::settings::Settings, shape: InputShape, products: crate::settings::Products, budget: f64, machine: &Machine, cal: &Calibration) -> crate::error::Result<(crate::settings::Settings, f64, f64)> {
+    let seconds = |job: &Job| step_work(job).iter().map(|(_, w)| machine.limit(w).0).sum::<f64>() / SHARE_OF_LIMIT;
+    for_budget_by(given, shape, products, budget, cal, None, seconds)
+}
+
+/// The one search for a time budget: among the specular sample counts and irradiance
+/// source sizes the error model `cal` measured, the pair with the lowest predicted error
+/// whose time, by `seconds`, fits `budget`. The predicted error is the specular bake's
+/// share of the shaded colour's error, its mean over `roughness` (the values a scene reads;
+/// every calibrated band if `None`), plus the irradiance's. Returns the settings, the
+/// predicted error and the estimated seconds; when nothing fits, the cheapest pair, whose
+/// estimate then exceeds `budget`.
+pub fn for_budget_by(
+    given: &crate::settings::Settings,
+    shape: InputShape,
+    products: crate::settings::Products,
+    budget: f64,
+    cal: &Calibration,
+    roughness: Option<&[f32]>,
+    seconds: impl Fn(&Job) -> f64,
+) -> crate::error::Result<(crate::settings::Settings, f64, f64)> {
     // Sample counts within the measured range only: the error model is flat outside it.
     let measured: Vec<u32> = cal.prefilter.iter().flat_map(|(_, t)| t.iter().map(|&(n, _)| n)).collect();
     let (lo, hi) = (measured.iter().copied().min().unwrap_or(64), measured.iter().copied().max().unwrap_or(64));
     let mut samples: Vec<u32> = measured.iter().copied().chain([8, 16, 32, 64, 128, 256, 512, 1024]).filter(|&n| n >= lo && n <= hi).collect();
     samples.sort_unstable();
     samples.dedup();
+    let bands: Vec<f32> = match roughness {
+        Some(r) if !r.is_empty() => r.to_vec(),
+        _ => cal.prefilter.iter().map(|(r, _)| *r).collect(),
+    };
     let source = given.resolve(shape, products)?.source_size;
     let sources: Vec<(u32, f64)> = cal.irradiance.iter().copied().filter(|&(s, _)| s <= source).collect();
     let mut best: Option<(crate::settings::Settings, f64, f64)> = None;
@@ -447,8 +468,8 @@ pub fn for_budget(given: &crate::settings::Settings, shape: InputShape, products
         for &(s, irradiance_error) in &sources {
             let settings = crate::settings::Settings { samples: n, irradiance_source: Some(s), ..given.clone() };
             let Ok(job) = settings.resolve(shape, products) else { continue };
-            let seconds: f64 = step_work(&job).iter().map(|(_, w)| machine.limit(w).0).sum::<f64>() / SHARE_OF_LIMIT;
-            let specular_error = cal.prefilter.iter().map(|(r, _)| cal.prefilter_error(*r, n)).sum::<f64>() / cal.prefilter.len().max(1) as f64;
+            let seconds = seconds(&job);
+            let specular_error = bands.iter().map(|r| cal.prefilter_error(*r, n)).sum::<f64>() / bands.len().max(1) as f64;
             let error = if products.specular { specular_error } else { 0.0 } + if products.irradiance { irradiance_error } else { 0.0 };
             let candidate = (settings, error, seconds);
             if seconds <= budget && best.as_ref().is_none_or(|b| error < b.1 || (error == b.1 && seconds < b.2)) {
