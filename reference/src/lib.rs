@@ -9,6 +9,7 @@
 
 #![cfg_attr(not(test), warn(unused_crate_dependencies))]
 pub mod quadrature;
+pub mod sheen;
 
 use crate::quadrature::adaptive;
 use std::f64::consts::PI;

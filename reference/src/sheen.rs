@@ -1,0 +1,89 @@
+//! The Charlie sheen lobe in f64, written from Estevez & Kulla 2017 ("Production Friendly
+//! Microfacet Sheen BRDF") and the `KHR_materials_sheen` text, sharing nothing with
+//! `splitsum_shaders::brdf::sheen`: angles instead of cosines (`sin θ` from `θ`), `exp`
+//! and `powf` instead of the shaders' polynomials, and the directional albedo integrated
+//! over the light direction in spherical coordinates by adaptive Gauss–Kronrod quadrature
+//! (the shaders' side samples half vectors).
+
+use crate::quadrature::adaptive;
+use std::f64::consts::PI;
+
+/// `α = r²` with `r` clamped to [10⁻⁶, 1], as the engines do.
+pub fn alpha(roughness: f64) -> f64 {
+    roughness.clamp(1e-6, 1.0).powi(2)
+}
+
+/// `D` at the angle `theta_h` between `h` and `n`: `(2 + 1/α)·sin(θ)^(1/α)/(2π)`.
+pub fn d_charlie_angle(theta_h: f64, alpha: f64) -> f64 {
+    (2.0 + 1.0 / alpha) * theta_h.sin().abs().powf(1.0 / alpha) / (2.0 * PI)
+}
+
+/// `D` at `n·h` (through the angle).
+pub fn d_charlie(n_dot_h: f64, alpha: f64) -> f64 {
+    d_charlie_angle(n_dot_h.clamp(-1.0, 1.0).acos(), alpha)
+}
+
+/// Estevez & Kulla's Table 1 fits, blended by `(1 − α)²`, and `Λ` from them.
+pub fn lambda_charlie(cos_theta: f64, alpha: f64) -> f64 {
+    let t = (1.0 - alpha).powi(2);
+    let fit = |x: f64| {
+        let p = [(21.5473, 25.3245), (3.82987, 3.32435), (0.19823, 0.16801), (-1.97760, -1.27393), (-4.32054, -4.85967)];
+        let [a, b, c, d, e] = p.map(|(lo, hi)| lo * (1.0 - t) + hi * t);
+        a / (1.0 + b * x.powf(c)) + d * x + e
+    };
+    let x = cos_theta.abs().min(1.0);
+    if x < 0.5 { fit(x).exp() } else { (2.0 * fit(0.5) - fit(1.0 - x)).exp() }
+}
+
+/// The Charlie visibility, clamped to [0, 1] as the Sample Viewer's `V_Sheen`.
+pub fn v_charlie(n_dot_l: f64, n_dot_v: f64, alpha: f64) -> f64 {
+    if n_dot_l <= 0.0 || n_dot_v <= 0.0 {
+        return 0.0;
+    }
+    (1.0 / ((1.0 + lambda_charlie(n_dot_v, alpha) + lambda_charlie(n_dot_l, alpha)) * 4.0 * n_dot_l * n_dot_v)).clamp(0.0, 1.0)
+}
+
+/// The Neubelt–Pettineo visibility, clamped to [0, 1] as glTF-IBL-Sampler's `V_Neubelt`.
+pub fn v_neubelt(n_dot_l: f64, n_dot_v: f64) -> f64 {
+    if n_dot_l <= 0.0 || n_dot_v <= 0.0 {
+        return 0.0;
+    }
+    (0.25 / (n_dot_l + n_dot_v - n_dot_l * n_dot_v)).clamp(0.0, 1.0)
+}
+
+/// Which visibility term a sheen integral uses.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Visibility {
+    /// Estevez & Kulla's fitted masking.
+    Charlie,
+    /// Neubelt & Pettineo's.
+    Neubelt,
+}
+
+/// The directional albedo `E(n·v) = ∫ D(h)·V·(n·l) dω_l` of the sheen BRDF (no Fresnel,
+/// colour 1) for the view at `n_dot_v` and perceptual sheen roughness `roughness`: over
+/// the light's polar angle and azimuth (mirror-symmetric about the plane of `n` and `v`,
+/// so over half the azimuth, doubled), to absolute tolerance `tol` per integral.
+pub fn albedo(n_dot_v: f64, roughness: f64, visibility: Visibility, tol: f64) -> f64 {
+    let a = alpha(roughness);
+    let v = [(1.0 - n_dot_v * n_dot_v).max(0.0).sqrt(), 0.0, n_dot_v];
+    let outer = |theta_l: f64| {
+        let (sl, cl) = theta_l.sin_cos();
+        let inner = |phi: f64| {
+            let l = [sl * phi.cos(), sl * phi.sin(), cl];
+            let h = [l[0] + v[0], l[1] + v[1], l[2] + v[2]];
+            let len = (h[0] * h[0] + h[1] * h[1] + h[2] * h[2]).sqrt();
+            if len == 0.0 {
+                return 0.0;
+            }
+            let theta_h = (h[2] / len).clamp(-1.0, 1.0).acos();
+            let vis = match visibility {
+                Visibility::Charlie => v_charlie(cl, n_dot_v, a),
+                Visibility::Neubelt => v_neubelt(cl, n_dot_v),
+            };
+            d_charlie_angle(theta_h, a) * vis * cl
+        };
+        2.0 * adaptive(&inner, 0.0, PI, tol) * sl
+    };
+    adaptive(&outer, 0.0, PI / 2.0, tol)
+}
