@@ -104,3 +104,150 @@ pub fn sample_charlie_tangent(xi: Vec2, alpha: f32) -> Vec3 {
     let (s, c) = math::sin_cos_turns(xi.x);
     Vec3::new(sin_t * c, sin_t * s, cos_t)
 }
+
+/// Which visibility term a sheen integral uses (see the module header for which engine
+/// reads which).
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum SheenVisibility {
+    /// Estevez & Kulla's fitted masking ([`v_charlie`]): the glTF Sample Viewer's sheen
+    /// albedo-scaling table (`lut_sheen_E`).
+    Charlie = 0,
+    /// Neubelt & Pettineo's ([`v_neubelt`]): glTF-IBL-Sampler's Charlie table (the blue
+    /// channel of its table, which the Sample Viewer reads for image-based sheen).
+    Neubelt = 1,
+}
+
+impl SheenVisibility {
+    /// The term at `n·l`, `n·v` for width `α`.
+    #[inline]
+    pub fn eval(self, n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
+        match self {
+            SheenVisibility::Charlie => v_charlie(n_dot_l, n_dot_v, alpha),
+            SheenVisibility::Neubelt => v_neubelt(n_dot_l, n_dot_v),
+        }
+    }
+}
+
+/// Equal pieces in θ of the sheen albedo's full-circle part.
+const FULL_PIECES: u32 = 8;
+/// Midpoint azimuths over `[0, π]` there (the integrand is smooth and periodic in φ).
+const FULL_AZIMUTHS: u32 = 32;
+/// Pieces of the arc part, geometric in `θ₂ − θ`.
+const ARC_PIECES: u32 = 16;
+/// Equal pieces of the arc's azimuth `[0, φₘ]`.
+const AZIMUTH_PIECES: u32 = 4;
+
+/// `D(h)·V·(n·l)·4(v·h)·sin θ` at the half vector `(sin θ, cos θ) = (st, ct)`, azimuth
+/// cosine `cos_phi` from the plane of `n` and `v`: the sheen albedo's integrand per
+/// `dθ dφ`, zero where `n·l ≤ 0`.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn albedo_term(vis: SheenVisibility, nv: f32, sv: f32, st: f32, ct: f32, cos_phi: f32, alpha: f32) -> f32 {
+    let vh = sv * st * cos_phi + nv * ct;
+    let nl = 2.0 * vh * ct - nv;
+    if nl > 0.0 && vh > 0.0 { d_charlie(ct, alpha) * vis.eval(nl, nv, alpha) * nl * 4.0 * vh * st } else { 0.0 }
+}
+
+/// The 10×10-point Gauss–Legendre sum over `θ ∈ [θa, θb]` (through
+/// `θ = θa + (θb − θa)(1 − cos πx)/2` where `ends`) and `φ ∈ [0, φₘ(θ)]`, doubled for the
+/// other half of the azimuth.
+#[allow(clippy::too_many_arguments)]
+fn arc_piece(vis: SheenVisibility, nv: f32, sv: f32, alpha: f32, ta: f32, tb: f32, ends: bool) -> f32 {
+    let mut total = 0.0;
+    let mut i = 0;
+    while i < crate::quadrature::GAUSS_LEGENDRE_POINTS {
+        let (x, w) = crate::quadrature::gauss_legendre_10(i);
+        let (t, dt) = if ends {
+            let (s, c) = math::sin_cos_turns(0.5 * x);
+            (0.5 * (1.0 - c), 0.5 * math::PI * s)
+        } else {
+            (x, 1.0)
+        };
+        let (st, ct) = math::sin_cos(ta + (tb - ta) * t);
+        // cos φₘ = cos θᵥ(1 − 2cos²θ)/(2 cos θ sin θ sin θᵥ) (`lut::arc_piece`'s boundary).
+        let c_star = math::clamp(nv * (1.0 - 2.0 * ct * ct) / (2.0 * ct * st * sv), -1.0, 1.0);
+        let phi_max = math::atan2(math::sqrt((1.0 - c_star) * (1.0 + c_star)), c_star);
+        let mut arc = 0.0;
+        let mut p = 0;
+        while p < AZIMUTH_PIECES {
+            let mut j = 0;
+            while j < crate::quadrature::GAUSS_LEGENDRE_POINTS {
+                let (y, wy) = crate::quadrature::gauss_legendre_10(j);
+                let (_, cos_phi) = math::sin_cos((p as f32 + y) * (1.0 / AZIMUTH_PIECES as f32) * phi_max);
+                arc += albedo_term(vis, nv, sv, st, ct, cos_phi, alpha) * wy * (1.0 / AZIMUTH_PIECES as f32);
+                j += 1;
+            }
+            p += 1;
+        }
+        total += arc * phi_max * 2.0 * (tb - ta) * dt * w;
+        i += 1;
+    }
+    total
+}
+
+/// The directional albedo `E(n·v) = ∫ D(h)·V·(n·l) dω_l` of the sheen lobe (colour 1, no
+/// Fresnel) at perceptual sheen roughness `roughness`, by deterministic quadrature: the
+/// sheen tables' integrand.
+///
+/// **Derivation.** Over half vectors, `dω_l = 4(v·h) dω_h` and `dω_h = sin θ dθ dφ`, so
+/// `E = ∫∫ D(θ)·V·(n·l)·4(v·h)·sin θ dθ dφ` where `n·l = 2(v·h)(n·h) − n·v > 0`. That
+/// region is the GGX table's (`lut::integrate_brdf_quadrature`): the whole azimuth for
+/// `θ < θ₁ = π/4 − θᵥ/2`, the arc `φ < φₘ(θ)` for `θ₁ ≤ θ ≤ θ₂ = π/4 + θᵥ/2`, nothing
+/// beyond. `D` grows towards `θ = π/2` as `sin(θ)^(1/α)`, so at grazing views the mass sits
+/// at the arc's closing end `θ₂`, where `φₘ` has a square-root end.
+///
+/// **Estimator.** `θ ∈ [0, θ₁]`: [`FULL_PIECES`] equal pieces, the 10-point
+/// Gauss–Legendre rule in θ, the midpoint rule with [`FULL_AZIMUTHS`] points in
+/// `φ ∈ [0, π]`. `θ ∈ [θ₁, θ₂]`: [`ARC_PIECES`] pieces in geometric progression of
+/// `θ₂ − θ` down to `min(θ₂ − θ₁, n·v)/256`, then the last piece to `θ₂`, the end pieces
+/// through `θ = θa + (θb − θa)(1 − cos πx)/2` to smooth the square-root ends; the 10-point
+/// rule in θ and on [`AZIMUTH_PIECES`] equal pieces of `φ ∈ [0, φₘ]` (the visibilities'
+/// clamp at 1 puts a kink inside the arc at grazing views, which one 10-point rule missed by
+/// 1.3·10⁻³). About 9 400 evaluations. `shaders/tests/sheen.rs` holds it within 10⁻⁴ of
+/// the f64 reference at 90 points (measured 7.3·10⁻⁵ at worst, n·v 0.002); every texel of
+/// a table is not checked yet.
+pub fn albedo(n_dot_v: f32, roughness: f32, vis: SheenVisibility) -> f32 {
+    let nv = math::clamp(n_dot_v, crate::lut::MIN_N_DOT_V, 1.0);
+    let alpha = alpha(roughness);
+    let sv = math::sqrt((1.0 - nv) * (1.0 + nv));
+    let theta_v = math::atan2(sv, nv);
+    let quarter = 0.25 * math::PI;
+    let (theta1, theta2) = (quarter - 0.5 * theta_v, quarter + 0.5 * theta_v);
+    let mut total = 0.0;
+    // θ ∈ [0, θ₁]: the whole circle.
+    let mut piece = 0;
+    while piece < FULL_PIECES {
+        let ta = theta1 * piece as f32 / FULL_PIECES as f32;
+        let tb = theta1 * (piece + 1) as f32 / FULL_PIECES as f32;
+        let mut i = 0;
+        while i < crate::quadrature::GAUSS_LEGENDRE_POINTS {
+            let (x, w) = crate::quadrature::gauss_legendre_10(i);
+            let (st, ct) = math::sin_cos(ta + (tb - ta) * x);
+            let mut ring = 0.0;
+            let mut j = 0;
+            while j < FULL_AZIMUTHS {
+                let (_, cos_phi) = math::sin_cos_turns((j as f32 + 0.5) / (2 * FULL_AZIMUTHS) as f32);
+                ring += albedo_term(vis, nv, sv, st, ct, cos_phi, alpha);
+                j += 1;
+            }
+            total += ring * (2.0 * math::PI / FULL_AZIMUTHS as f32) * (tb - ta) * w;
+            i += 1;
+        }
+        piece += 1;
+    }
+    // θ ∈ [θ₁, θ₂]: the arc. Empty at n·v = 1.
+    if theta2 > theta1 {
+        let d_max = theta2 - theta1;
+        let d_min = math::min(d_max, nv) * (1.0 / 256.0);
+        let step = math::log2(d_max / d_min) / ARC_PIECES as f32;
+        let mut k = 0;
+        while k <= ARC_PIECES {
+            let ta = theta2 - d_max * math::exp2(-step * k as f32);
+            let tb = if k == ARC_PIECES { theta2 } else { theta2 - d_max * math::exp2(-step * (k + 1) as f32) };
+            total += arc_piece(vis, nv, sv, alpha, ta, tb, k == 0 || k == ARC_PIECES);
+            k += 1;
+        }
+    }
+    total
+}
