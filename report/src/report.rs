@@ -972,16 +972,13 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         let _ = writeln!(md, "| {} | ![]({}) | ![]({}) | ![]({}) |", caption(what, map), picture(k, "splitsum"), picture(k, "exact"), picture(k, "error"));
     }
     let _ = writeln!(md, "\n![scale](surface_scale.svg)");
-    if let Some((title, header, cells)) = &ladder {
-        let _ = writeln!(md, "\n## {title}\n\n{LADDER_NOTE}\n\n![the shading ladder](ladder.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-        for c in cells {
-            let _ = writeln!(md, "| {} |", c.join(" | "));
-        }
-    }
-    if let Some((title, header, cells)) = &budget {
-        let _ = writeln!(md, "\n## {title}\n\n{BUDGET_NOTE}\n\n![the budget curve](budget.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-        for c in cells {
-            let _ = writeln!(md, "| {} |", c.join(" | "));
+    let figures = [(&ladder, LADDER_NOTE, "ladder", "the shading ladder", "error against ns per shaded pixel, one point per rung"), (&budget, BUDGET_NOTE, "budget", "the budget curve", "error against the time budget, one point per budget")];
+    for (table, note, id, alt, _) in figures {
+        if let Some((title, header, cells)) = table {
+            let _ = writeln!(md, "\n## {title}\n\n{note}\n\n![{alt}]({id}.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
+            for c in cells {
+                let _ = writeln!(md, "| {} |", c.join(" | "));
+            }
         }
     }
     if !set_tables.is_empty() {
@@ -1020,31 +1017,20 @@ fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, ro
         );
     }
     let _ = writeln!(html, "<img src=\"surface_scale.svg\" alt=\"error scale\">");
-    if let Some((title, header, cells)) = &ladder {
-        let _ = writeln!(
-            html,
-            "<h2 id=\"ladder\">{}</h2>\n<p>{}</p>\n<figure><img src=\"ladder.svg\" alt=\"error against ns per shaded pixel, one point per rung\"></figure>\n<table><tr>{}</tr>",
-            html_escape(title),
-            html_escape(LADDER_NOTE),
-            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
-        );
-        for c in cells {
-            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
+    for (table, note, id, _, alt) in figures {
+        if let Some((title, header, cells)) = table {
+            let _ = writeln!(
+                html,
+                "<h2 id=\"{id}\">{}</h2>\n<p>{}</p>\n<figure><img src=\"{id}.svg\" alt=\"{alt}\"></figure>\n<table><tr>{}</tr>",
+                html_escape(title),
+                html_escape(note),
+                header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
+            );
+            for c in cells {
+                let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
+            }
+            let _ = writeln!(html, "</table>");
         }
-        let _ = writeln!(html, "</table>");
-    }
-    if let Some((title, header, cells)) = &budget {
-        let _ = writeln!(
-            html,
-            "<h2 id=\"budget\">{}</h2>\n<p>{}</p>\n<figure><img src=\"budget.svg\" alt=\"error against the time budget, one point per budget\"></figure>\n<table><tr>{}</tr>",
-            html_escape(title),
-            html_escape(BUDGET_NOTE),
-            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
-        );
-        for c in cells {
-            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
-        }
-        let _ = writeln!(html, "</table>");
     }
     if !set_tables.is_empty() {
         let _ = writeln!(html, "<h2>Tuning and held-out sets</h2>\n<p>{}</p>", html_escape(SETS_NOTE));

@@ -15,7 +15,7 @@ use crate::cubemap::{self, CubeLayout};
 use crate::math::MeanPartial;
 use crate::{calibrate, equirect, half, irradiance, lut, prefilter};
 use bytemuck::{Pod, Zeroable};
-use spirv_std::glam::{UVec3, Vec4};
+use spirv_std::glam::{UVec3, Vec3, Vec4};
 use spirv_std::spirv;
 
 /// Parameters of [`brdf_lut`].
@@ -209,11 +209,7 @@ pub fn prefilter_specular(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
 ) {
-    let s = p.dst_size;
-    if id.x < s && id.y < s && id.z < cubemap::FACES {
-        let layout = CubeLayout::new(p.src_size, p.src_levels);
-        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
-        let n = cubemap::texel_dir(id.z, id.x, id.y, s);
+    if let Some((layout, i, n)) = prefilter_invocation(id, p) {
         let partial = load_partial(accum, i);
         store_partial(accum, i, prefilter::accumulate(src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial));
     }
@@ -229,13 +225,22 @@ pub fn prefilter_exact(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] src: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
 ) {
-    let s = p.dst_size;
-    if id.x < s && id.y < s && id.z < cubemap::FACES {
-        let layout = CubeLayout::new(p.src_size, p.src_levels);
-        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
-        let n = cubemap::texel_dir(id.z, id.x, id.y, s);
+    if let Some((layout, i, n)) = prefilter_invocation(id, p) {
         let partial = load_partial(accum, i);
         store_partial(accum, i, prefilter::exact_accumulate(src, layout, p.exact_level, n, p.roughness, p.start, p.count, partial));
+    }
+}
+
+/// The texel a prefilter kernel's invocation `id` works on: the source cube's layout, the
+/// texel's index in the output's sums and its direction; nothing outside the level.
+#[inline]
+fn prefilter_invocation(id: UVec3, p: &PrefilterParams) -> Option<(CubeLayout, usize, Vec3)> {
+    let s = p.dst_size;
+    if id.x < s && id.y < s && id.z < cubemap::FACES {
+        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
+        Some((CubeLayout::new(p.src_size, p.src_levels), i, cubemap::texel_dir(id.z, id.x, id.y, s)))
+    } else {
+        None
     }
 }
 

@@ -169,6 +169,30 @@ fn add_sample(src: &[Vec4], layout: CubeLayout, n: Vec3, t: Vec3, b: Vec3, g: Ve
     }
 }
 
+/// Adds samples `start .. start + count` of `total` around `n` to `p`, sample `i` being
+/// `sample(i)` ([`ggx_sample`]'s form): the sums both [`accumulate`] and
+/// [`accumulate_samples`] run.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+fn accumulate_with(src: &[Vec4], layout: CubeLayout, n: Vec3, total: u32, start: u32, count: u32, p: MeanPartial, sample: impl Fn(u32) -> Vec4) -> MeanPartial {
+    // A zero or non-finite direction is read as +z rather than turned into NaN.
+    let n = sampling::normalize_or(n, Vec3::Z);
+    // Weights n·l/N sum to at most 1: no overflow, whatever the radiance.
+    let inv_count = 1.0 / total.max(1) as f32;
+    let mut acc = math::CompensatedSum4::resume(p.sum, p.carry);
+    let mut wsum = math::CompensatedSum::resume(p.weight.x, p.weight.y);
+    let (t, b) = sampling::orthonormal_basis(n);
+    let mut i = start;
+    let end = start + count;
+    while i < end {
+        add_sample(src, layout, n, t, b, sample(i), inv_count, &mut acc, &mut wsum);
+        i += 1;
+    }
+    let (sum, carry) = acc.parts();
+    let (w, wc) = wsum.parts();
+    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
+}
+
 /// Adds GGX samples `start .. start + count` (of `samples` in all) around `n` to `p`.
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate(
@@ -182,43 +206,17 @@ pub fn accumulate(
     lod_bias: f32,
     p: MeanPartial,
 ) -> MeanPartial {
-    // A zero or non-finite direction is read as +z rather than turned into NaN.
-    let n = sampling::normalize_or(n, Vec3::Z);
     let alpha = alpha_from_roughness(math::saturate(roughness));
     let total = samples.max(1);
-    // Weights n·l/N sum to at most 1: no overflow, whatever the radiance.
-    let inv_count = 1.0 / total as f32;
-    let mut acc = math::CompensatedSum4::resume(p.sum, p.carry);
-    let mut wsum = math::CompensatedSum::resume(p.weight.x, p.weight.y);
-    let (t, b) = sampling::orthonormal_basis(n);
-    let mut i = start;
-    let end = start + count;
-    while i < end {
-        add_sample(src, layout, n, t, b, ggx_sample(i, total, alpha, layout.size, lod_bias), inv_count, &mut acc, &mut wsum);
-        i += 1;
-    }
-    let (sum, carry) = acc.parts();
-    let (w, wc) = wsum.parts();
-    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
+    let size = layout.size;
+    accumulate_with(src, layout, n, total, start, count, p, |i| ggx_sample(i, total, alpha, size, lod_bias))
 }
 
 /// [`accumulate`] with the samples read from `table` (all of them, [`ggx_samples`]) instead
 /// of made per texel: the same values.
+#[cfg(not(target_arch = "spirv"))]
 pub fn accumulate_samples(src: &[Vec4], layout: CubeLayout, n: Vec3, table: &[Vec4], start: u32, count: u32, p: MeanPartial) -> MeanPartial {
-    let n = sampling::normalize_or(n, Vec3::Z);
-    let inv_count = 1.0 / table.len().max(1) as f32;
-    let mut acc = math::CompensatedSum4::resume(p.sum, p.carry);
-    let mut wsum = math::CompensatedSum::resume(p.weight.x, p.weight.y);
-    let (t, b) = sampling::orthonormal_basis(n);
-    let mut i = start;
-    let end = start + count;
-    while i < end {
-        add_sample(src, layout, n, t, b, table[i as usize], inv_count, &mut acc, &mut wsum);
-        i += 1;
-    }
-    let (sum, carry) = acc.parts();
-    let (w, wc) = wsum.parts();
-    MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
+    accumulate_with(src, layout, n, table.len() as u32, start, count, p, |i| table[i as usize])
 }
 
 /// [`prefilter_dir`] from a table of its samples ([`ggx_samples`] of a non-zero roughness):

@@ -129,6 +129,10 @@ impl SheenVisibility {
     }
 }
 
+/// The smallest `n·v` the albedo is integrated at (a view exactly in the surface has no
+/// arc left to integrate; 10⁻⁴ is below the first texel centre of any table up to 4096²).
+pub const MIN_N_DOT_V: f32 = 1e-4;
+
 /// Equal pieces in θ of the sheen albedo's full-circle part.
 const FULL_PIECES: u32 = 8;
 /// Midpoint azimuths over `[0, π]` there (the integrand is smooth and periodic in φ).
@@ -208,7 +212,7 @@ fn arc_piece(vis: SheenVisibility, nv: f32, sv: f32, alpha: f32, ta: f32, tb: f3
 /// the f64 reference at 90 points (measured 7.3·10⁻⁵ at worst, n·v 0.002); every texel of
 /// a table is not checked yet.
 pub fn albedo(n_dot_v: f32, roughness: f32, vis: SheenVisibility) -> f32 {
-    let nv = math::clamp(n_dot_v, crate::lut::MIN_N_DOT_V, 1.0);
+    let nv = math::clamp(n_dot_v, MIN_N_DOT_V, 1.0);
     let alpha = alpha(roughness);
     let sv = math::sqrt((1.0 - nv) * (1.0 + nv));
     let theta_v = math::atan2(sv, nv);
