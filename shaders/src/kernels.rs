@@ -529,7 +529,7 @@ pub fn read_cube(
     }
 }
 
-/// Parameters of [`calibrate`].
+/// Parameters of [`calibrate()`].
 #[derive(Copy, Clone, Debug, Pod, Zeroable)]
 #[repr(C)]
 pub struct CalibrateParams {

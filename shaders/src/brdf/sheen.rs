@@ -201,12 +201,12 @@ fn arc_piece(vis: SheenVisibility, nv: f32, sv: f32, alpha: f32, ta: f32, tb: f3
 /// beyond. `D` grows towards `θ = π/2` as `sin(θ)^(1/α)`, so at grazing views the mass sits
 /// at the arc's closing end `θ₂`, where `φₘ` has a square-root end.
 ///
-/// **Estimator.** `θ ∈ [0, θ₁]`: [`FULL_PIECES`] equal pieces, the 10-point
-/// Gauss–Legendre rule in θ, the midpoint rule with [`FULL_AZIMUTHS`] points in
-/// `φ ∈ [0, π]`. `θ ∈ [θ₁, θ₂]`: [`ARC_PIECES`] pieces in geometric progression of
+/// **Estimator.** `θ ∈ [0, θ₁]`: `FULL_PIECES` equal pieces, the 10-point
+/// Gauss–Legendre rule in θ, the midpoint rule with `FULL_AZIMUTHS` points in
+/// `φ ∈ [0, π]`. `θ ∈ [θ₁, θ₂]`: `ARC_PIECES` pieces in geometric progression of
 /// `θ₂ − θ` down to `min(θ₂ − θ₁, n·v)/256`, then the last piece to `θ₂`, the end pieces
 /// through `θ = θa + (θb − θa)(1 − cos πx)/2` to smooth the square-root ends; the 10-point
-/// rule in θ and on [`AZIMUTH_PIECES`] equal pieces of `φ ∈ [0, φₘ]` (the visibilities'
+/// rule in θ and on `AZIMUTH_PIECES` equal pieces of `φ ∈ [0, φₘ]` (the visibilities'
 /// clamp at 1 puts a kink inside the arc at grazing views, which one 10-point rule missed by
 /// 1.3·10⁻³). About 9 400 evaluations. `shaders/tests/sheen.rs` holds it within 10⁻⁴ of
 /// the f64 reference at 90 points (measured 7.3·10⁻⁵ at worst, n·v 0.002); every texel of
