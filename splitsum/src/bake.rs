@@ -274,7 +274,8 @@ pub struct Batched {
 /// device and one set of pipelines for all, the next input read (on a thread of its own)
 /// while the current one bakes, and each bake handed to `deliver` on a third thread (so
 /// writing it overlaps the next bake). An input that fails to read or bake is handed over as
-/// its error and the others go on. Returns what `deliver` returned, in the order of `paths`.
+/// its error and the others go on; `deliver` gets the input's index in `paths` and its path.
+/// Returns what `deliver` returned, in the order of `paths`.
 /// The settings are checked once, before anything is read.
 pub fn bake_batch<R: Send>(
     backend: &Backend,
@@ -282,7 +283,7 @@ pub fn bake_batch<R: Send>(
     settings: &Settings,
     products: Products,
     sanitize: bool,
-    deliver: impl Fn(&std::path::Path, Result<Batched>) -> R + Sync,
+    deliver: impl Fn(usize, &std::path::Path, Result<Batched>) -> R + Sync,
 ) -> Result<Vec<R>> {
     use std::sync::mpsc::sync_channel;
     let face = settings.resolve(InputShape::Unknown, products)?.source_size;
@@ -297,7 +298,7 @@ pub fn bake_batch<R: Send>(
             }
         });
         let deliver = &deliver;
-        let writer = s.spawn(move || baked_rx.into_iter().map(|(i, b)| deliver(&paths[i], b)).collect::<Vec<R>>());
+        let writer = s.spawn(move || baked_rx.into_iter().map(|(i, b)| deliver(i, &paths[i], b)).collect::<Vec<R>>());
         for (i, read) in read_rx {
             let batched = read.and_then(|(env, input)| {
                 let job = settings.resolve(InputShape::of(&env), products)?;

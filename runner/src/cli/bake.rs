@@ -153,9 +153,8 @@ fn batch_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
     let backend = Backend::open(args.backend)?;
     println!("baking {} environments on {} for {} into {}", args.env.len(), backend.describe(), settings.target.name(), args.out.display());
     let start = Instant::now();
-    let index = |p: &std::path::Path| args.env.iter().position(|q| q == p).expect("one of the batch");
-    let results = splitsum::bake_batch(&backend, &args.env, &settings, products, args.sanitize, |path, batched| -> anyhow::Result<()> {
-        let out = outs[index(path)].lock().unwrap_or_else(|e| e.into_inner()).take().expect("each output once");
+    let results = splitsum::bake_batch(&backend, &args.env, &settings, products, args.sanitize, |index, path, batched| -> anyhow::Result<()> {
+        let out = outs[index].lock().unwrap_or_else(|e| e.into_inner()).take().expect("each output once");
         let b = batched.map_err(crate::cli::bake_error)?;
         for a in &b.adjustments {
             eprintln!("note: {}: {}", path.display(), a.describe(&flag_of));
