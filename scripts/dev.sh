@@ -142,7 +142,7 @@ case "$cmd" in
         # the same GPU-vs-CPU bounds as on Vulkan.
         echo "dev.sh: the GPU tests on GL (WGPU_BACKEND=gl)" >&2
         WGPU_BACKEND=gl cargo +stable test --release -p splitsum-tests --test suite "$@" -- \
-            prefilter:: lut:: equirect:: irradiance:: stability:: library:: render:: targets::
+            prefilter:: lut:: equirect:: irradiance:: stability:: library:: render:: targets:: sheen::
         ;;
     peers)
         ensure_peers
@@ -170,11 +170,13 @@ case "$cmd" in
         exec cargo +stable package --workspace --exclude splitsum-tests --exclude runner "$@"
         ;;
     table)
-        # The BRDF table the library embeds (splitsum/src/table.rs), computed afresh.
+        # The tables the library embeds (splitsum/src/table.rs), computed afresh.
         ensure_stable
         f=splitsum/assets/brdf_table_256_quadrature_correlated.f32
+        g=splitsum/assets/sheen_tables_64.f32
         [ -f "$f" ] || : > "$f"
-        exec cargo +stable run --release -q -p splitsum --features internals --example embedded_table -- "$f"
+        [ -f "$g" ] || : > "$g"
+        exec cargo +stable run --release -q -p splitsum --features internals --example embedded_table -- "$f" "$g"
         ;;
     spirv)
         ensure_nightly

@@ -27,10 +27,11 @@ fn every_choice_decodes_as_it_encodes() {
     use splitsum_shaders::brdf::microfacet::Masking;
     use splitsum_shaders::equirect::Facing;
     use splitsum_shaders::kernels::ProbeMode;
-    use splitsum_shaders::prefilter::RoughnessMapping;
+    use splitsum_shaders::prefilter::{Lobe, RoughnessMapping};
     use splitsum_shaders::shade::{DiffuseModel, FresnelForm, SpecularModel};
     use splitsum_shaders::tonemap::Tonemapper;
     round_trip(RoughnessMapping::from_u32);
+    round_trip(Lobe::from_u32);
     round_trip(Masking::from_u32);
     round_trip(Facing::from_u32);
     round_trip(Tonemapper::from_u32);

@@ -155,7 +155,7 @@ fn reading_for_a_cube_reduces_the_image_and_keeps_its_power() {
     assert!((reduced_power / power - 1.0).abs() < 1e-5, "power {reduced_power} vs {power}");
 
     let settings = splitsum::settings::Settings::default();
-    let products = splitsum::settings::Products { specular: true, irradiance: true, sh9: false, lut: false };
+    let products = splitsum::settings::Products { specular: true, irradiance: true, sh9: false, lut: false, sheen: false };
     let a = splitsum::bake::bake(&Backend::Cpu, &reduced, &settings, products).unwrap();
     let b = splitsum::bake::bake(&Backend::Cpu, &full, &settings, products).unwrap();
     // Both source cubes hold the file's power, the sun's included: the resampling keeps a

@@ -26,7 +26,8 @@ fn loads_with_node_transforms_and_every_texture() {
     let m = splitsum_display::model::load(&sample_path()).unwrap();
     assert_eq!(m.primitives.len(), 1);
     let p = &m.primitives[0];
-    assert!(p.textures.iter().all(|t| t.is_some()), "all five slots");
+    assert!(p.textures[..5].iter().all(|t| t.is_some()), "all five metallic–roughness slots");
+    assert!(p.textures[5..].iter().all(|t| t.is_none()), "no sheen textures (the model has no KHR_materials_sheen)");
     assert_eq!(p.material.textures.x, 0b11111);
     assert_eq!(p.material.emissive.truncate(), Vec3::splat(4.0));
     assert!(p.textures[0].as_ref().unwrap().srgb && !p.textures[2].as_ref().unwrap().srgb);

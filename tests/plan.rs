@@ -56,6 +56,40 @@ fn a_full_scene_keeps_everything() {
     assert!((p.cost.cpu_seconds - p.full_cost.cpu_seconds).abs() < 1e-9);
 }
 
+/// Sheen is baked only for a lit material with a sheen colour, and only the mips its
+/// sheen roughness reads (linear: lod = r·(M − 1)), or for a glTF model whose file uses
+/// `KHR_materials_sheen`; a scene without sheen does no sheen work: no sheen step runs in
+/// its bake, no sheen product is made.
+#[test]
+fn sheen_is_baked_only_where_a_material_has_it() {
+    let plain = planned(&scene("", &material("plain", "roughness = [0.2, 0.6]")));
+    assert!(!plain.job.products.sheen && skipped(&plain, "sheen cube and tables"));
+    let env = Environment::Equirect(support::environment("courtyard"));
+    let baked = splitsum::bake::bake_job(&Backend::Cpu, &env, &plain.job).unwrap();
+    assert!(baked.sheen.is_none() && baked.sheen_tables.is_none());
+    assert!(!baked.timings.iter().any(|t| matches!(t.step, splitsum::settings::Step::Sheen | splitsum::settings::Step::SheenTables)), "{:?}", baked.timings);
+    let black = planned(&scene("", &material("black", "sheen_color = [0.0, 0.0, 0.0]\nsheen_roughness = 0.5")));
+    assert!(!black.job.products.sheen, "a black sheen colour is no sheen");
+    let unlit = planned(&scene("", &material("unlit", "ibl = false\nsheen_color = [1.0, 1.0, 1.0]")));
+    assert!(!unlit.job.products.sheen, "a material not lit by the environment reads no sheen cube");
+    // A glTF model whose file has KHR_materials_sheen needs the sheen cube, every mip.
+    let dir = std::env::temp_dir().join(format!("splitsum-plan-sheen-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let glb = dir.join("velvet.glb");
+    std::fs::write(&glb, support::model::sample_glb_with(Some(serde_json::json!({"KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5]}})))).unwrap();
+    let text = format!("[[materials]]\nname = \"m\"\nroughness = \"texture\"\nmetallic = \"texture\"\n\n[[objects]]\nkind = \"gltf\"\npath = {:?}\nmaterial = \"m\"\n", glb.display().to_string());
+    let p = planned(&scene("", &text));
+    assert!(p.job.products.sheen && p.job.sheen_levels == (0..p.job.mips).collect::<Vec<_>>(), "{:?}", p.decisions);
+    let torus = planned(&scene("", &model("m", "roughness = \"texture\"\nmetallic = \"texture\"")));
+    assert!(!torus.job.products.sheen, "the torus has no sheen");
+    let _ = std::fs::remove_dir_all(&dir);
+    let velvet = planned(&scene("", &material("velvet", "sheen_color = [0.8, 0.2, 0.2]\nsheen_roughness = [0.3, 0.5]")));
+    assert!(velvet.job.products.sheen);
+    let top = (velvet.job.mips - 1) as f32;
+    let want: Vec<u32> = ((0.3 * top).floor() as u32..=(0.5 * top).ceil() as u32).collect();
+    assert_eq!(velvet.job.sheen_levels, want, "the sheen mips around sheen roughness 0.3–0.5 of {} mips", velvet.job.mips);
+}
+
 #[test]
 fn no_specular_image_light_drops_the_prefilter_and_the_table() {
     for fields in ["specular = \"none\"", "specular = \"none\"\ndiffuse = \"oren-nayar\""] {

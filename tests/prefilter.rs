@@ -145,10 +145,10 @@ fn exact_sums_of_rough_mips_match_the_brute_force_reference() {
     // Bounds: measured 3.8 % at r = 1 over the 16² level (the sampled estimator at 1024
     // samples: 10.4 % on the same probes, `matches_the_brute_force_reference`), with 1.5×.
     for (rough, bound) in [(1.0f32, 0.06), (0.6, 0.06)] {
-        let level = (0..city.layout.levels).find(|&l| city.layout.level_size(l) == prefilter::exact_source_size(rough, 64)).unwrap();
+        let level = (0..city.layout.levels).find(|&l| city.layout.level_size(l) == prefilter::exact_source_size(prefilter::Lobe::Ggx, rough, 64)).unwrap();
         let mut worst = 0.0f64;
         for n in probe_dirs() {
-            let got = prefilter::exact_dir(&city.texels, city.layout, level, n, rough);
+            let got = prefilter::exact_dir(prefilter::Lobe::Ggx, &city.texels, city.layout, level, n, rough);
             let want = reference::prefilter(&texels, [n.x as f64, n.y as f64, n.z as f64], rough as f64);
             let lum = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
             worst = worst.max((lum([got.x as f64, got.y as f64, got.z as f64]) - lum(want)).abs() / lum(want));
@@ -157,8 +157,8 @@ fn exact_sums_of_rough_mips_match_the_brute_force_reference() {
         assert!(worst < bound, "r {rough}: {worst}");
     }
     // At the defaults (64 samples at mip 1, doubling), only the last mip is summed.
-    assert!(prefilter::prefers_exact(1.0, 1024, 256) && !prefilter::prefers_exact(0.595, 512, 256));
-    assert!(!prefilter::prefers_exact(0.21, 128, 256) && !prefilter::prefers_exact(0.0, 1 << 20, 256));
+    assert!(prefilter::prefers_exact(prefilter::Lobe::Ggx, 1.0, 1024, 256) && !prefilter::prefers_exact(prefilter::Lobe::Ggx, 0.595, 512, 256));
+    assert!(!prefilter::prefers_exact(prefilter::Lobe::Ggx, 0.21, 128, 256) && !prefilter::prefers_exact(prefilter::Lobe::Ggx, 0.0, 1 << 20, 256));
 }
 
 /// The exact sums on the GPU equal the CPU's, and a constant sky stays constant.
@@ -171,13 +171,13 @@ fn exact_sums_gpu_match_cpu_and_keep_a_constant() {
     let r = [0.0, 0.3, 0.6, 1.0];
     let samples = [64, 64, 512, 1024];
     let all = [0, 1, 2, 3];
-    let g = gpu().prefilter_levels(&city, out, &r, &all, &samples, true, 0.5).unwrap();
-    let cpu = Backend::Cpu.prefilter_levels(&city, out, &r, &all, &samples, true, 0.5).unwrap();
+    let g = gpu().prefilter_levels(splitsum_shaders::prefilter::Lobe::Ggx, &city, out, &r, &all, &samples, true, 0.5).unwrap();
+    let cpu = Backend::Cpu.prefilter_levels(splitsum_shaders::prefilter::Lobe::Ggx, &city, out, &r, &all, &samples, true, 0.5).unwrap();
     let rel = max_relative(&g.texels, &cpu.texels, 1e-3);
     println!("exact sums of rough mips, gpu vs cpu: max relative {rel:.2e}");
     let bound = support::gpu_bound(1e-5, 5e-5) as f32;
     assert!(rel < bound, "{rel:e}");
-    let f = Backend::Cpu.prefilter_levels(&flat, out, &r, &all, &samples, true, 0.5).unwrap();
+    let f = Backend::Cpu.prefilter_levels(splitsum_shaders::prefilter::Lobe::Ggx, &flat, out, &r, &all, &samples, true, 0.5).unwrap();
     let rel = max_relative(&f.texels, &vec![c; f.texels.len()], 0.0);
     assert!(rel < 2e-6, "constant sky: {rel:e}");
 }

@@ -120,7 +120,7 @@ fn shading_is_finite_at_the_extremes() {
             let v = Vec3::new((1.0 - nv * nv).sqrt(), 0.0, nv);
             for metallic in [0.0f32, 1.0] {
                 for &radiance in &[0.0f32, 1e-40, 1e4, 1e6, MAX_RADIANCE] {
-                    let m = Material { base_color: Vec3::ONE, metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
+                    let m = Material { base_color: Vec3::ONE, metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
                     for diffuse in 0..(<shade::DiffuseModel as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
                         for specular in 0..(<shade::SpecularModel as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
                             for fresnel in 0..(<shade::FresnelForm as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
@@ -178,6 +178,10 @@ fn the_shading_ladder_keeps_a_constant_sky_constant() {
             source_size: size,
             source_levels: 1,
             irradiance_levels: 1,
+            sheen_size: size,
+            sheen_levels: cube.layout.levels,
+            sheen_mapping: RoughnessMapping::Linear as u32,
+            sheen_table_size: splitsum::table::SHEEN_TABLE_SIZE,
         };
         for n in hard_directions().into_iter().filter(|n| n.length() > 0.5) {
             let (t, _) = sampling::orthonormal_basis(n);
@@ -185,7 +189,7 @@ fn the_shading_ladder_keeps_a_constant_sky_constant() {
                 let v = (n * nv + t * (1.0 - nv * nv).sqrt()).normalize();
                 for &r in &ROUGHNESS {
                     for metallic in [0.0f32, 1.0] {
-                        let m = Material { base_color: Vec3::new(0.9, 0.5, 0.2), metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
+                        let m = Material { base_color: Vec3::new(0.9, 0.5, 0.2), metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
                         for fetches in [2, 4, 8, 16] {
                             let opts = ShadeOptions::DEFAULT.with_fetches(fetches);
                             assert_eq!(opts.fetches(), fetches);
@@ -233,7 +237,15 @@ fn extreme_environment_bakes_and_renders_finite() {
     };
     for b in backends() {
         let baked = bake::bake(b, &env, &settings, Products::ALL).unwrap();
-        let all = baked.source.as_ref().unwrap().texels.iter().chain(&baked.specular.as_ref().unwrap().texels).chain(&baked.irradiance.as_ref().unwrap().texels);
+        let all = baked
+            .source
+            .as_ref()
+            .unwrap()
+            .texels
+            .iter()
+            .chain(&baked.specular.as_ref().unwrap().texels)
+            .chain(&baked.irradiance.as_ref().unwrap().texels)
+            .chain(&baked.sheen.as_ref().expect("Products::ALL bakes sheen").texels);
         for t in all {
             assert!(t.is_finite(), "{}: {t}", b.describe());
         }

@@ -17,5 +17,6 @@ mod portability;
 mod prefilter;
 mod render;
 mod report;
+mod sheen;
 mod stability;
 mod targets;

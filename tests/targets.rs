@@ -522,8 +522,9 @@ fn every_ktx_file_loads_in_libktx() {
             }
         }
     }
-    // splitsum ×2 (specular, irradiance), khronos 2, bevy 3 (and 3 in RGB9_E5), filament 2.
-    assert_eq!(checked, 14, "KTX files checked");
+    // splitsum ×2 (specular, irradiance), khronos 3 (specular, diffuse, sheen), bevy 3 (and
+    // 3 in RGB9_E5), filament 2.
+    assert_eq!(checked, 15, "KTX files checked");
 }
 
 /// The khronos target against glTF-IBL-Sampler itself, on the same `.hdr`: the same face
@@ -668,6 +669,64 @@ fn khronos_target_matches_gltf_ibl_sampler() {
     let (es, ek) = (es / (mips - 1) as f64, ek / (mips - 1) as f64);
     println!("mips 1-{}: mean error splitsum {:.3} %, glTF-IBL-Sampler {:.3} %", mips - 1, 100.0 * es, 100.0 * ek);
     assert!(es < ek, "splitsum's error {es} is not below glTF-IBL-Sampler's {ek}");
+
+    // Sheen: glTF-IBL-Sampler's Charlie cube (`-distribution Charlie`, its 1024 samples)
+    // against splitsum's `charlie/sheen.ktx2` from the bake above: same size, faces and mip
+    // count, sheen roughness m/(mips − 1) per mip (lib.cpp, as for GGX); per mip the median
+    // difference, and the mean error of each against the exact Charlie-weighted sum
+    // (`reference::sheen::prefilter` over the sky averaged to a 64² cube; at sheen roughness
+    // 0, α → 0, the weight concentrates on the horizon: the mean of the sky round it, 4096
+    // points). Target: the median difference within 2 %, or splitsum nearer the exact
+    // integral where they differ more.
+    let kcharlie = d.join("k_sheen.ktx2");
+    run(&["-inputPath", env.to_str().unwrap(), "-outCubeMap", kcharlie.to_str().unwrap(), "-distribution", "Charlie", "-cubeMapResolution", "128", "-sampleCount", "1024"]);
+    let kc = read_ktx2(&kcharlie);
+    let sc = read_ktx2(&out.join("charlie/sheen.ktx2"));
+    assert_eq!((sc.size, sc.faces, sc.levels.len()), (kc.size, kc.faces, kc.levels.len()), "sheen: same size, faces and mip count");
+    let sheen_r: Vec<f64> = manifest["settings"]["sheen_roughness_per_mip"].as_array().unwrap().iter().map(|r| r.as_f64().unwrap()).collect();
+    let half: Vec<splitsum_shaders::glam::Vec4> = (0..6u32)
+        .flat_map(|f| (0..64u32).flat_map(move |y| (0..64u32).map(move |x| (f, x, y))))
+        .map(|(f, x, y)| (0..4).map(|k| cube[((f * s + 2 * y + k / 2) * s + 2 * x + k % 2) as usize]).sum::<splitsum_shaders::glam::Vec4>() * 0.25)
+        .collect();
+    let coarse = reference::Environment::new(&half, 64);
+    let khronos_sky = |k: [f64; 3]| sky([k[2], k[1], -k[0]]);
+    for (m, &r) in sheen_r.iter().enumerate() {
+        assert!((r - m as f64 / (mips - 1) as f64).abs() < 1e-6, "sheen mip {m} at roughness {r}");
+        let size = s >> m;
+        let med = median(sc.levels[m].iter().zip(&kc.levels[m]).map(|(a, b)| rel(*a, *b)).collect());
+        let step = (size / 8).max(1);
+        let probes: Vec<(u32, u32, u32)> = (0..6).flat_map(|f| (0..size).step_by(step as usize).flat_map(move |y| (0..size).step_by(step as usize).map(move |x| (f, x, y)))).collect();
+        use rayon::prelude::*;
+        let want: Vec<f64> = probes
+            .par_iter()
+            .map(|&(f, x, y)| {
+                let n = reference::texel_dir(f, x, y, size);
+                let c = if r == 0.0 {
+                    let t = reference::normalize(if n[1].abs() < 0.9 { [n[2], 0.0, -n[0]] } else { [0.0, -n[2], n[1]] });
+                    let b = [n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]];
+                    let mut acc = [0.0; 3];
+                    for k in 0..4096 {
+                        let (sn, cs) = (std::f64::consts::TAU * k as f64 / 4096.0).sin_cos();
+                        let v = khronos_sky([t[0] * cs + b[0] * sn, t[1] * cs + b[1] * sn, t[2] * cs + b[2] * sn]);
+                        (0..3).for_each(|ch| acc[ch] += v[ch] / 4096.0);
+                    }
+                    acc
+                } else {
+                    reference::sheen::prefilter(&coarse, n, r)
+                };
+                0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+            })
+            .collect();
+        let err = |level: &[[f32; 4]]| probes.iter().zip(&want).map(|(&(f, x, y), w)| (luminance(level[((f * size + y) * size + x) as usize]) - w).abs() / w).sum::<f64>() / probes.len() as f64;
+        let (e_s, e_k) = (err(&sc.levels[m]), err(&kc.levels[m]));
+        println!(
+            "sheen mip {m} (sheen roughness {r:.3}): median difference {:.2} %; mean error against the exact integral: splitsum {:.2} %, glTF-IBL-Sampler {:.2} %",
+            100.0 * med,
+            100.0 * e_s,
+            100.0 * e_k
+        );
+        assert!(med <= 0.02 || e_s < e_k, "sheen mip {m}: median difference {med}, and splitsum's error {e_s} is not below glTF-IBL-Sampler's {e_k}");
+    }
 }
 
 /// Six faces are taken as they are, except where the engine's baker mirrors them: cmgen

@@ -38,8 +38,11 @@ pub struct Texture {
     pub srgb: bool,
 }
 
-/// The texture slots of a glTF metallic–roughness material.
-pub const SLOTS: usize = 5;
+/// The texture slots of a glTF metallic–roughness material with `KHR_materials_sheen`.
+pub const SLOTS: usize = 7;
+
+/// The name of the sheen extension (Khronos, `KHR_materials_sheen`).
+const SHEEN: &str = "KHR_materials_sheen";
 
 /// A drawable piece: triangles sharing one material.
 #[derive(Clone, Debug)]
@@ -50,7 +53,8 @@ pub struct Primitive {
     pub indices: Vec<u32>,
     /// Material factors and which textures exist.
     pub material: MeshMaterial,
-    /// Base colour, metallic–roughness, normal, occlusion, emissive.
+    /// Base colour, metallic–roughness, normal, occlusion, emissive, sheen colour, sheen
+    /// roughness.
     pub textures: [Option<Texture>; SLOTS],
     /// Drawn from both sides.
     pub double_sided: bool,
@@ -133,6 +137,20 @@ pub fn load(path: &Path) -> Result<Model> {
         from_document(path, doc, buffers, images)
     }))
     .unwrap_or_else(malformed)
+}
+
+/// Whether the `.gltf` or `.glb` file at `path` has a material with a sheen layer
+/// (`KHR_materials_sheen` with a sheen colour above black, or a sheen colour texture):
+/// read from its JSON alone, no buffer or image decoded. For a scene's plan.
+pub fn uses_sheen(path: &Path) -> Result<bool> {
+    let bytes = read_regular(path, None)?;
+    let doc = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| Error::file(path, format!("cannot load the glTF: {e}")))?;
+    Ok(doc.materials().any(|m| {
+        m.extension_value(SHEEN).is_some_and(|e| {
+            e.get("sheenColorTexture").is_some()
+                || e.get("sheenColorFactor").and_then(|f| f.as_array()).is_some_and(|f| f.iter().any(|c| c.as_f64().is_some_and(|c| c > 0.0)))
+        })
+    }))
 }
 
 /// The name of the Draco extension (Khronos, `KHR_draco_mesh_compression`).
@@ -431,12 +449,35 @@ fn primitive(
             None => Ok(None),
         }
     };
+    // KHR_materials_sheen: its factors (default black and 0: no sheen) and textures, by
+    // index into the document's textures.
+    let sheen = mat.extension_value(SHEEN);
+    let sheen_texture = |key: &str| -> Result<Option<gltf::texture::Texture>> {
+        match sheen.and_then(|e| e.get(key)).map(|t| t.get("index").and_then(serde_json::Value::as_u64)) {
+            None => Ok(None),
+            Some(Some(i)) => doc.textures().nth(i as usize).map(Some).ok_or_else(|| Error::file(path, format!("{SHEEN}: {key} names texture {i}, which does not exist"))),
+            Some(None) => Err(Error::file(path, format!("{SHEEN}: {key} has no texture index"))),
+        }
+    };
+    let factor = |key: &str, n: usize, default: f32| -> Result<Vec<f32>> {
+        match sheen.and_then(|e| e.get(key)) {
+            None => Ok(vec![default; n]),
+            Some(v) => {
+                let values: Option<Vec<f32>> = if n == 1 { v.as_f64().map(|x| vec![x as f32]) } else { v.as_array().map(|a| a.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect()) };
+                values.filter(|v| v.len() == n && v.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))).ok_or_else(|| Error::file(path, format!("{SHEEN}: {key} must be {n} number(s) in [0, 1], not {v}")))
+            }
+        }
+    };
+    let sheen_color = factor("sheenColorFactor", 3, 0.0)?;
+    let sheen_roughness = factor("sheenRoughnessFactor", 1, 0.0)?[0];
     let textures = [
         texture(pbr.base_color_texture().map(|i| i.texture()), true)?,
         texture(pbr.metallic_roughness_texture().map(|i| i.texture()), false)?,
         texture(mat.normal_texture().map(|i| i.texture()), false)?,
         texture(mat.occlusion_texture().map(|i| i.texture()), false)?,
         texture(mat.emissive_texture().map(|i| i.texture()), true)?,
+        texture(sheen_texture("sheenColorTexture")?, true)?,
+        texture(sheen_texture("sheenRoughnessTexture")?, false)?,
     ];
     let bits = textures.iter().enumerate().fold(0u32, |b, (k, t)| b | ((t.is_some() as u32) << k));
     let material = MeshMaterial {
@@ -446,6 +487,7 @@ fn primitive(
         textures: splitsum_shaders::glam::UVec4::new(bits, 0, 0, 0),
         ranges: Vec4::new(0.0, 1.0, 0.0, 1.0),
         options: splitsum_shaders::shade::ShadeOptions::DEFAULT,
+        sheen: Vec4::new(sheen_color[0], sheen_color[1], sheen_color[2], sheen_roughness),
     };
     Ok(Primitive { vertices, indices, material, textures, double_sided: mat.double_sided() })
 }

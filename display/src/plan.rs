@@ -78,6 +78,7 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     let specular_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.specular != SpecularModel::None).collect();
     let ggx: Vec<&MaterialSpec> = specular_ibl.iter().copied().filter(|m| m.specular == SpecularModel::CookTorrance).collect();
     let diffuse_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.metallic.range().0 < 1.0).collect();
+    let sheen_ibl: Vec<&MaterialSpec> = lit.iter().copied().filter(|m| m.has_sheen()).collect();
     let names = |v: &[&MaterialSpec]| v.iter().map(|m| m.name.as_str()).collect::<Vec<_>>().join(", ");
 
     // Cube size from the smallest roughness and the output resolution: the level that
@@ -176,6 +177,33 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     } else if !lit.is_empty() {
         decide("irradiance cube", false, "every lit material is metal (metallic = 1): no diffuse term".into());
     }
+    // Sheen: the Charlie cube's mips the sheen roughness reads (linear: lod = r·(M − 1), as
+    // the glTF Sample Viewer reads it) and the sheen tables, only for materials with sheen.
+    // A lit glTF model whose file has KHR_materials_sheen reads every sheen mip (its sheen
+    // roughness comes from the file, factors and textures).
+    let model_sheen = match scene.model_path() {
+        Some(path) if lit.iter().any(|m| scene.objects.iter().any(|o| matches!(o, crate::scene::ObjectSpec::Gltf { material, .. } if *material == m.name))) => {
+            crate::model::uses_sheen(&path)?.then_some(path)
+        }
+        _ => None,
+    };
+    let sheen_levels: Vec<u32> = {
+        let mut read = std::collections::BTreeSet::new();
+        let top = (mips - 1) as f32;
+        let ranges = sheen_ibl.iter().map(|m| m.sheen_roughness.range()).chain(model_sheen.iter().map(|_| (0.0, 1.0)));
+        for (a, b) in ranges {
+            read.extend(((a.clamp(0.0, 1.0) * top).floor() as u32)..=((b.clamp(0.0, 1.0) * top).ceil() as u32).min(mips - 1));
+        }
+        read.into_iter().collect()
+    };
+    let sheen = !sheen_levels.is_empty();
+    if sheen {
+        let kept: Vec<String> = sheen_levels.iter().map(|&l| format!("{l} (r={:.2})", splitsum::settings::SHEEN_MAPPING.roughness(l, mips))).collect();
+        let whose: Vec<String> = sheen_ibl.iter().map(|m| m.name.clone()).chain(model_sheen.iter().map(|p| format!("{} (KHR_materials_sheen)", p.display()))).collect();
+        decide("sheen cube and tables", true, format!("sheen of {}; mips {}", whose.join(", "), kept.join(", ")));
+    } else if !lit.is_empty() {
+        decide("sheen cube and tables", false, "no lit material has sheen (sheen_color is black, and no model uses KHR_materials_sheen)".into());
+    }
     if !lit.is_empty() {
         decide("SH9", false, "the display reads the irradiance cube; SH9 is for `runner bake ENV`".into());
     }
@@ -195,7 +223,7 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     // A time budget: the lowest predicted error over the roughness the scene reads that fits
     // (estimated on lavapipe's built-in rates, for the levels the plan keeps).
     if let Some(budget) = q.max_seconds {
-        let products = Products { specular, irradiance, sh9: false, lut };
+        let products = Products { specular, irradiance, sh9: false, lut, sheen };
         let seconds = |job: &splitsum::Job| job.clone().with_levels(levels.clone()).map_or(f64::INFINITY, |j| splitsum::cost::step_seconds(&j, cal, true).total());
         let (chosen, error, estimate) = splitsum::cost::for_budget_by(&settings, shape, products, budget, cal, Some(&needed_r), seconds)?;
         let fits = if estimate <= budget { "fits" } else { "is the cheapest measured, over" };
@@ -239,11 +267,11 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
         _ => settings.irradiance_source,
     };
 
-    let products = Products { specular, irradiance, sh9: false, lut };
-    let job = settings.resolve(shape, products)?.with_levels(levels)?;
+    let products = Products { specular, irradiance, sh9: false, lut, sheen };
+    let job = settings.resolve(shape, products)?.with_levels(levels)?.with_sheen_levels(sheen_levels)?;
     let cost = estimate(&job, cal);
     let full_cost = estimate(&settings.resolve(shape, Products::DISPLAY)?, cal);
-    let default_cost = estimate(&Settings::default().resolve(shape, Products::ALL)?, cal);
+    let default_cost = estimate(&Settings::default().resolve(shape, Products::STANDARD)?, cal);
     Ok(Plan { job, decisions: d, cost, full_cost, default_cost })
 }
 

@@ -82,7 +82,7 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
     colour.par_chunks_mut(w).zip(depth.par_chunks_mut(w)).enumerate().for_each(|(y, (crow, drow))| {
         for x in 0..w {
             let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            let (c, d) = scene::radiance_depth(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, px);
+            let (c, d) = scene::radiance_depth(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &env.sheen.texels, &env.sheen_tables.texels, px);
             crow[x] = c;
             drow[x] = d;
         }
@@ -164,10 +164,30 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
         let uv = uv_at(f.bary);
         let (dx, dy) = (uv_at(f.quad[1]) - uv_at(f.quad[0]), uv_at(f.quad[2]) - uv_at(f.quad[0]));
         let read = |k: usize| textures[f.prim][k].as_ref().map_or(Vec4::ONE, |tex| tex.sample(uv, dx, dy));
-        let texels = Texels { base_color: read(0), metallic_roughness: read(1), normal: read(2), occlusion: read(3), emissive: read(4) };
+        let texels = Texels {
+            base_color: read(0),
+            metallic_roughness: read(1),
+            normal: read(2),
+            occlusion: read(3),
+            emissive: read(4),
+            sheen_color: read(5),
+            sheen_roughness: read(6),
+        };
         let (m, n) = surface::material(&prim.material, &texels, normal, tangent);
         let view = splitsum_shaders::sampling::normalize_or(frame.eye.truncate() - position, n);
-        *c = scene::shade_point(frame, prim.material.options, &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &m, position, n, view);
+        *c = scene::shade_point(
+            frame,
+            prim.material.options,
+            &env.specular.texels,
+            &env.irradiance.texels,
+            &env.lut.texels,
+            &env.sheen.texels,
+            &env.sheen_tables.texels,
+            &m,
+            position,
+            n,
+            view,
+        );
     });
     colour.into_iter().map(|c| scene::to_display(frame, c)).collect()
 }

@@ -50,6 +50,10 @@ pub struct ViewState {
     pub base_color: Vec3,
     /// The grid's metalness range (top to bottom row) and roughness range (left to right).
     pub grid_ranges: Vec4,
+    /// Sheen colour of the spheres (black: none).
+    pub sheen_color: Vec3,
+    /// The grid's sheen roughness range (left to right column).
+    pub sheen_ranges: (f32, f32),
     /// Direct lights.
     pub lights: Vec<Light>,
 }
@@ -71,6 +75,8 @@ impl Default for ViewState {
             show_model: false,
             base_color: Vec3::new(0.9, 0.45, 0.2),
             grid_ranges: Vec4::new(0.0, 1.0, 0.0, 1.0),
+            sheen_color: Vec3::ZERO,
+            sheen_ranges: (0.0, 0.0),
             lights: vec![
                 Light { position: Vec4::new(-0.5, 0.8, 0.6, 0.0).normalize() * Vec4::new(1.0, 1.0, 1.0, 0.0), radiance: Vec4::new(3.0, 2.9, 2.7, 0.0) },
                 Light { position: Vec4::new(3.0, 2.0, 4.0, 1.0), radiance: Vec4::new(20.0, 20.0, 24.0, 0.0) },
@@ -180,6 +186,8 @@ impl ViewState {
             // `z = −near` maps to 0 and `−far` to 1.
             view_proj: rh::proj::directx::perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * rh::view::look_to_mat4(eye, forward, up),
             grid_ranges: self.grid_ranges,
+            sheen_color: self.sheen_color.extend(0.0),
+            sheen_ranges: Vec4::new(self.sheen_ranges.0, self.sheen_ranges.1, 0.0, 0.0),
         }
     }
 }
@@ -252,7 +260,7 @@ pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
     out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
         for (x, p) in row.iter_mut().enumerate() {
             let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            *p = scene::pixel(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, px);
+            *p = scene::pixel(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &env.sheen.texels, &env.sheen_tables.texels, px);
         }
     });
     out
@@ -289,11 +297,13 @@ impl GpuScene {
         let irradiance = gpu.upload_bytes("irradiance", bytemuck::cast_slice(&env.irradiance.texels));
         let lut = gpu.upload_bytes("brdf lut", bytemuck::cast_slice(&env.lut.texels));
         let source = gpu.upload_bytes("source", bytemuck::cast_slice(env.source.level(0)));
+        let sheen = gpu.upload_bytes("sheen", bytemuck::cast_slice(&env.sheen.texels));
+        let sheen_tables = gpu.upload_bytes("sheen tables", bytemuck::cast_slice(&env.sheen_tables.texels));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,
             // In the order of `splitsum_shaders::display`'s group 1: frame, specular,
-            // irradiance, table, source.
+            // irradiance, table, source, sheen cube, sheen tables.
             entries: &group_entries(
                 &DISPLAY,
                 1,
@@ -303,6 +313,8 @@ impl GpuScene {
                     irradiance.as_entire_binding(),
                     lut.as_entire_binding(),
                     source.as_entire_binding(),
+                    sheen.as_entire_binding(),
+                    sheen_tables.as_entire_binding(),
                 ],
             ),
         });

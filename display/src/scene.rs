@@ -65,6 +65,13 @@ pub enum Param {
     Texture(String),
 }
 
+impl MaterialSpec {
+    /// Whether the material has a sheen layer (a sheen colour above black).
+    pub fn has_sheen(&self) -> bool {
+        self.sheen_color.iter().any(|&c| c > 0.0)
+    }
+}
+
 impl Param {
     /// The range of values `[lo, hi]`.
     pub fn range(&self) -> (f32, f32) {
@@ -91,6 +98,13 @@ pub struct MaterialSpec {
     /// Perceptual roughness.
     #[serde(default = "half")]
     pub roughness: Param,
+    /// Sheen colour (linear RGB; `KHR_materials_sheen`'s `sheenColorFactor`): black, the
+    /// default, is no sheen.
+    #[serde(default)]
+    pub sheen_color: [f32; 3],
+    /// Sheen roughness (`sheenRoughnessFactor`, perceptual; the lobe's `α` is its square).
+    #[serde(default = "zero")]
+    pub sheen_roughness: Param,
     /// Diffuse model.
     #[serde(default, with = "named")]
     pub diffuse: DiffuseModel,
@@ -577,6 +591,8 @@ impl Scene {
             let (r0, r1) = m.roughness.range();
             v.grid = (rows.max(1), columns.max(1));
             v.grid_ranges = Vec4::new(m0, m1, r0, r1);
+            v.sheen_color = Vec3::from(m.sheen_color);
+            v.sheen_ranges = m.sheen_roughness.range();
             v.base_color = Vec3::from(m.base_color);
             v.options = m.options();
         } else if let Some(m) = model {
@@ -590,6 +606,14 @@ impl Scene {
             v.target = Vec3::from(t);
         }
         v
+    }
+
+    /// The path of the scene's glTF model, if it has one (resolved against the scene file).
+    pub fn model_path(&self) -> Option<PathBuf> {
+        self.objects.iter().find_map(|o| match o {
+            ObjectSpec::Gltf { path, .. } => Some(self.resolve(path)),
+            ObjectSpec::SphereGrid { .. } => None,
+        })
     }
 
     /// The scene's glTF model (at most one, `check`), with its material's models and

@@ -87,3 +87,27 @@ pub fn albedo(n_dot_v: f64, roughness: f64, visibility: Visibility, tol: f64) ->
     };
     adaptive(&outer, 0.0, PI / 2.0, tol)
 }
+
+/// The sheen-prefiltered radiance (glTF-IBL-Sampler's Charlie filter, `v = n`) that the
+/// sheen cube converges to, by an exact sum over `texels` (as [`crate::texels`] lists them):
+/// `L̃(n) = Σ L D(h) (n·l) Ω / Σ D(h) (n·l) Ω` over `n·l > 0`, `h = (n + l)/|n + l|`.
+/// `D` is taken through the angle of `h` and divided by its value at 45° (the largest over
+/// `n·l ≥ 0`) in the log domain, `exp((ln sin²θ − ln ½)/(2α))`, so that no weight
+/// underflows before the ratio; a texel is split into sub-patches where the ring the lobe
+/// makes about the horizon (`4α/(1 + 4α)` wide in `n·l`) is narrower than eight of them.
+pub fn prefilter(env: &crate::Environment, n: [f64; 3], roughness: f64) -> [f64; 3] {
+    let a = alpha(roughness);
+    let w = |l: [f64; 3]| {
+        let nl = crate::dot(n, l);
+        if nl <= 0.0 {
+            return [0.0; 3];
+        }
+        let h = crate::normalize([n[0] + l[0], n[1] + l[1], n[2] + l[2]]);
+        let theta = crate::dot(n, h).clamp(-1.0, 1.0).acos();
+        let d = ((theta.sin().powi(2).ln() - 0.5f64.ln()) / (2.0 * a)).exp();
+        [d * nl; 3]
+    };
+    let width = 4.0 * a / (1.0 + 4.0 * a);
+    let (acc, wsum) = env.integrate(w, |_| width);
+    if wsum[0] > 0.0 { acc.map(|v| v / wsum[0]) } else { [0.0; 3] }
+}

@@ -57,7 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let raw: Vec<f32> = std::fs::read(&points)?.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
                 let shape = baked.shape();
                 for &r in &ROUGHNESS {
-                    let m = Material { base_color: Vec3::ONE, metallic: 1.0, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
+                    let m = Material { base_color: Vec3::ONE, metallic: 1.0, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
                     for &k in &FETCHES {
                         let opts = ShadeOptions { flags: ShadeOptions::DEFAULT.flags & !ShadeOptions::DIRECT, ..ShadeOptions::DEFAULT }.with_fetches(k);
                         let mut out = Vec::with_capacity(raw.len() / 2);

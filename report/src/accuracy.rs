@@ -182,7 +182,7 @@ impl Points {
                     (n, (n * nv + tangent(n, turn) * (1.0 - nv * nv).sqrt()).normalize())
                 }
             };
-            let material = Material { base_color: base, metallic: (i % 2) as f32, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
+            let material = Material { base_color: base, metallic: (i % 2) as f32, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
             pts.push((material, n, v));
         }
         let shading: Vec<ShadingPoint> = pts

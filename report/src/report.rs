@@ -382,7 +382,7 @@ impl References {
                         let (t, b) = sampling::orthonormal_basis(n);
                         let side = if k % 2 == 0 { t } else { b };
                         let v = (n * nv + side * (1.0 - nv * nv).sqrt()).normalize();
-                        let material = Material { base_color: Vec3::new(0.9, 0.6, 0.3), metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
+                        let material = Material { base_color: Vec3::new(0.9, 0.6, 0.3), metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
                         shading.push(ShadingPoint { material, n, v, full: [0.0; 3], exact_split: Vec3::ZERO });
                     }
                 }

@@ -75,7 +75,7 @@ pub fn error_map(baked: &BakedEnvironment, env: &reference::Environment) -> Erro
     let mut points = Vec::new();
     for row in 0..rows {
         for (col, &r) in ROUGHNESS.iter().enumerate() {
-            let material = Material { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 1.0 - row as f32, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO };
+            let material = Material { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 1.0 - row as f32, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
             for y in 0..d {
                 for x in 0..d {
                     let (px, py) = ((x as f32 + 0.5) / RADIUS as f32 - 1.0, 1.0 - (y as f32 + 0.5) / RADIUS as f32);

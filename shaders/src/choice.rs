@@ -6,7 +6,7 @@
 
 use crate::brdf::microfacet::Masking;
 use crate::equirect::Facing;
-use crate::prefilter::RoughnessMapping;
+use crate::prefilter::{Lobe, RoughnessMapping};
 use crate::shade::{DiffuseModel, FresnelForm, SpecularModel};
 use crate::tonemap::Tonemapper;
 
@@ -74,6 +74,7 @@ macro_rules! choice {
 }
 
 choice!(RoughnessMapping: Linear => "linear", Quadratic => "quadratic", Geometric => "geometric", Filament => "filament");
+choice!(Lobe: Ggx => "ggx", Charlie => "charlie");
 choice!(Masking: SmithSchlick => "schlick", SmithCorrelated => "correlated");
 choice!(Facing: NegZ => "-z", PosX => "+x", PosZ => "+z", NegX => "-x");
 choice!(Tonemapper: Aces => "aces", Reinhard => "reinhard", Clamp => "clamp");

@@ -3,8 +3,9 @@
 //!
 //! Bindings (set 1, so they never meet the compute kernels' set 0): 0 the [`Frame`]
 //! uniform, 1 the specular cube, 2 the irradiance cube, 3 the BRDF table, 4 the source
-//! cube (read-only storage buffers, filtered in software by `cubemap` and `lut`). Meshes
-//! add set 2: their [`MeshMaterial`], five textures and a sampler.
+//! cube, 5 the sheen cube, 6 the sheen tables (read-only storage buffers, filtered in
+//! software by `cubemap` and `lut`). Meshes add set 2: their [`MeshMaterial`], seven
+//! textures and a sampler.
 
 use crate::sampling;
 use crate::scene::{self, Frame};
@@ -30,10 +31,12 @@ pub fn scene_fs(
     #[spirv(storage_buffer, descriptor_set = 1, binding = 2)] irradiance: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 1, binding = 3)] table: &[Vec2],
     #[spirv(storage_buffer, descriptor_set = 1, binding = 4)] source: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 1, binding = 5)] sheen: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 1, binding = 6)] sheen_tables: &[Vec2],
     output: &mut Vec4,
     #[spirv(frag_depth)] depth: &mut f32,
 ) {
-    let (c, d) = scene::radiance_depth(frame, source, specular, irradiance, table, Vec2::new(coord.x, coord.y));
+    let (c, d) = scene::radiance_depth(frame, source, specular, irradiance, table, sheen, sheen_tables, Vec2::new(coord.x, coord.y));
     *output = scene::to_display(frame, c);
     *depth = d;
 }
@@ -72,13 +75,17 @@ pub fn mesh_fs(
     #[spirv(storage_buffer, descriptor_set = 1, binding = 1)] specular: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 1, binding = 2)] irradiance: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 1, binding = 3)] table: &[Vec2],
+    #[spirv(storage_buffer, descriptor_set = 1, binding = 5)] sheen: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 1, binding = 6)] sheen_tables: &[Vec2],
     #[spirv(uniform, descriptor_set = 2, binding = 0)] material: &MeshMaterial,
     #[spirv(descriptor_set = 2, binding = 1)] base_color: &Image!(2D, type = f32, sampled),
     #[spirv(descriptor_set = 2, binding = 2)] metallic_roughness: &Image!(2D, type = f32, sampled),
     #[spirv(descriptor_set = 2, binding = 3)] normal_map: &Image!(2D, type = f32, sampled),
     #[spirv(descriptor_set = 2, binding = 4)] occlusion: &Image!(2D, type = f32, sampled),
     #[spirv(descriptor_set = 2, binding = 5)] emissive: &Image!(2D, type = f32, sampled),
-    #[spirv(descriptor_set = 2, binding = 6)] sampler: &Sampler,
+    #[spirv(descriptor_set = 2, binding = 6)] sheen_color: &Image!(2D, type = f32, sampled),
+    #[spirv(descriptor_set = 2, binding = 7)] sheen_roughness: &Image!(2D, type = f32, sampled),
+    #[spirv(descriptor_set = 2, binding = 8)] sampler: &Sampler,
     output: &mut Vec4,
 ) {
     let texels = Texels {
@@ -87,9 +94,11 @@ pub fn mesh_fs(
         normal: normal_map.sample(*sampler, uv),
         occlusion: occlusion.sample(*sampler, uv),
         emissive: emissive.sample(*sampler, uv),
+        sheen_color: sheen_color.sample(*sampler, uv),
+        sheen_roughness: sheen_roughness.sample(*sampler, uv),
     };
     let (m, n) = surface::material(material, &texels, normal, tangent);
     let v = sampling::normalize_or(frame.eye.truncate() - position, n);
-    let c = scene::shade_point(frame, material.options, specular, irradiance, table, &m, position, n, v);
+    let c = scene::shade_point(frame, material.options, specular, irradiance, table, sheen, sheen_tables, &m, position, n, v);
     *output = scene::to_display(frame, c);
 }

@@ -13,6 +13,7 @@
 use crate::brdf::microfacet::Masking;
 use crate::cubemap::{self, CubeLayout};
 use crate::math::MeanPartial;
+use crate::prefilter::Lobe;
 use crate::{calibrate, equirect, half, irradiance, lut, prefilter};
 use bytemuck::{Pod, Zeroable};
 use spirv_std::glam::{UVec3, Vec3, Vec4};
@@ -180,6 +181,8 @@ pub struct PrefilterParams {
     /// The source level summed exactly (`prefilter::exact_accumulate`), or
     /// `prefilter::SAMPLED`.
     pub exact_level: u32,
+    /// The distribution (`prefilter::Lobe`): GGX for the specular cube, Charlie for sheen.
+    pub lobe: u32,
 }
 
 /// Reads the three `Vec4` of a [`MeanPartial`] at `accum[3i..]`.
@@ -196,7 +199,8 @@ fn store_partial(accum: &mut [Vec4], i: usize, p: MeanPartial) {
     accum[3 * i + 2] = p.weight;
 }
 
-/// One chunk of GGX samples of one texel of one level of the prefiltered specular cube:
+/// One chunk of samples of one texel of one level of a prefiltered cube (specular: GGX;
+/// sheen: Charlie, by `lobe`):
 /// adds them to the texel's partial sums in `accum` (three `Vec4` per texel);
 /// [`resolve_means`] resolves the means once every chunk has run
 /// (`prefilter::accumulate`, `MeanPartial::resolve`). The exact sums are a kernel of their
@@ -211,7 +215,7 @@ pub fn prefilter_specular(
 ) {
     if let Some((layout, i, n)) = prefilter_invocation(id, p) {
         let partial = load_partial(accum, i);
-        store_partial(accum, i, prefilter::accumulate(src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial));
+        store_partial(accum, i, prefilter::accumulate(Lobe::from_u32(p.lobe), src, layout, n, p.roughness, p.samples, p.start, p.count, p.lod_bias, partial));
     }
 }
 
@@ -227,7 +231,7 @@ pub fn prefilter_exact(
 ) {
     if let Some((layout, i, n)) = prefilter_invocation(id, p) {
         let partial = load_partial(accum, i);
-        store_partial(accum, i, prefilter::exact_accumulate(src, layout, p.exact_level, n, p.roughness, p.start, p.count, partial));
+        store_partial(accum, i, prefilter::exact_accumulate(Lobe::from_u32(p.lobe), src, layout, p.exact_level, n, p.roughness, p.start, p.count, partial));
     }
 }
 
@@ -357,7 +361,7 @@ pub fn probe_chunk(p: &ProbeParams, input: &[Vec4], q: Vec4, out: &mut [Vec4], i
         out[3 * i] = lut::accumulate(q.x, q.y, p.samples, p.start, p.chunk, out[3 * i]);
     } else if p.mode == ProbeMode::Prefilter as u32 {
         let partial = load_partial(out, i);
-        store_partial(out, i, prefilter::accumulate(input, layout, q.truncate(), q.w, p.samples, p.start, p.chunk, p.lod_bias, partial));
+        store_partial(out, i, prefilter::accumulate(Lobe::Ggx, input, layout, q.truncate(), q.w, p.samples, p.start, p.chunk, p.lod_bias, partial));
     } else if p.mode == ProbeMode::Irradiance as u32 {
         let partial = load_partial(out, i);
         store_partial(out, i, irradiance::accumulate(input, layout, p.src_level, cubemap::INLINE_GEOMETRY, q.truncate(), p.start, p.chunk, partial));
@@ -423,7 +427,7 @@ pub fn resolve_lut(
 }
 
 /// One texel of a mirror level (roughness 0) of the specular cube: the source read along
-/// the texel's direction (`prefilter::prefilter_texel`, no sum), written at `dst_offset`.
+/// the texel's direction (`prefilter::mirror_texel`, no sum), written at `dst_offset`.
 #[spirv(compute(threads(8, 8)))]
 pub fn prefilter_mirror(
     #[spirv(global_invocation_id)] id: UVec3,
@@ -435,7 +439,7 @@ pub fn prefilter_mirror(
     if id.x < s && id.y < s && id.z < cubemap::FACES {
         let layout = CubeLayout::new(p.src_size, p.src_levels);
         let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
-        out[i] = prefilter::prefilter_texel(src, layout, id.z, id.x, id.y, s, p.roughness, p.samples, p.lod_bias, prefilter::SAMPLED);
+        out[i] = prefilter::mirror_texel(src, layout, id.z, id.x, id.y, s);
     }
 }
 

@@ -23,6 +23,7 @@
 //!   some 550 evaluations per texel on average (the derivation is on the function).
 
 use crate::brdf::microfacet::Masking;
+use crate::brdf::sheen::{self, SheenVisibility};
 use crate::brdf::{alpha_from_roughness, fresnel, microfacet};
 use crate::math::{self, CompensatedSum};
 use crate::{quadrature, sampling};
@@ -334,4 +335,14 @@ pub fn integrate_brdf_quadrature(n_dot_v: f32, roughness: f32, masking: Masking)
 pub fn texel_quadrature(x: u32, y: u32, size: u32, masking: Masking) -> Vec2 {
     let c = texel_coords(x, y, size);
     integrate_brdf_quadrature(c.x, c.y, masking)
+}
+
+/// Texel `(x, y)` of the sheen tables (x = n·v, y = sheen roughness, at texel centres as
+/// [`texel_coords`]): the Charlie table with Neubelt's visibility (`x`; the blue channel
+/// of glTF-IBL-Sampler's table, which the glTF Sample Viewer reads as `u_CharlieLUT`) and
+/// the sheen albedo with the fitted Charlie visibility (`y`; the Sample Viewer's
+/// `lut_sheen_E`, `u_SheenELUT`, for `albedoSheenScaling`): `brdf::sheen::albedo` each.
+pub fn sheen_texel(x: u32, y: u32, size: u32) -> Vec2 {
+    let c = texel_coords(x, y, size);
+    Vec2::new(sheen::albedo(c.x, c.y, SheenVisibility::Neubelt), sheen::albedo(c.x, c.y, SheenVisibility::Charlie))
 }

@@ -198,6 +198,20 @@ pub fn log2(x: f32) -> f32 {
     e as f32 + s * core::f32::consts::LOG2_E
 }
 
+/// ln(1 + x) for `x ≥ 0`, accurate to a few ulp where `1 + x` would round `x` away: below
+/// 0.01 by `2·atanh(x/(2 + x))` to the seventh power (truncation below 10⁻¹⁹), else through
+/// [`log2`].
+#[inline]
+pub fn ln_1p(x: f32) -> f32 {
+    if x < 0.01 {
+        let z = x / (2.0 + x);
+        let z2 = z * z;
+        2.0 * z * (1.0 + z2 * (1.0 / 3.0 + z2 * (0.2 + z2 * (1.0 / 7.0))))
+    } else {
+        log2(1.0 + x) * core::f32::consts::LN_2
+    }
+}
+
 /// What [`log2`] returns for `x ≤ 0`: below log₂ of the smallest subnormal (−149).
 pub const LOG2_FLOOR: f32 = -150.0;
 

@@ -22,12 +22,17 @@
 //! noise. [`exact_source_size`] picks the level (eight texels per `α`), and [`prefers_exact`]
 //! takes the exact sum where its `6t²` terms cost less than the samples (a sample costs
 //! about eight texel terms: a trilinear lookup and the GGX terms).
+//!
+//! **The sheen cube** ([`Lobe::Charlie`]) is the same mean with the Charlie distribution
+//! in place of GGX (glTF-IBL-Sampler's `-distribution Charlie`): its samples and weights
+//! are `brdf::sheen`'s ([`charlie_sample`]). It has no mirror: at sheen roughness 0 the lobe
+//! is the horizon ring, which its samples trace.
 
-use crate::brdf::{alpha_from_roughness, microfacet};
+use crate::brdf::{alpha_from_roughness, microfacet, sheen};
 use crate::cubemap::{self, CubeLayout};
 use crate::math::{self, MeanPartial};
 use crate::sampling;
-use spirv_std::glam::{Vec3, Vec4};
+use spirv_std::glam::{Vec2, Vec3, Vec4};
 
 /// How the mips of the prefiltered cube map to roughness.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -99,6 +104,43 @@ impl RoughnessMapping {
     }
 }
 
+/// The distribution a prefiltered cube is filtered with.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+#[repr(u32)]
+pub enum Lobe {
+    /// GGX (Trowbridge–Reitz): the specular cube.
+    Ggx = 0,
+    /// Charlie (Estevez & Kulla 2017; `brdf::sheen`): the sheen cube.
+    Charlie = 1,
+}
+
+impl Lobe {
+    /// The lobe's width for perceptual `roughness`: GGX's `α`, or the sheen's
+    /// (`sheen::alpha`, `r` clamped to at least 10⁻⁶).
+    #[inline]
+    pub fn alpha(self, roughness: f32) -> f32 {
+        match self {
+            Lobe::Ggx => alpha_from_roughness(math::saturate(roughness)),
+            Lobe::Charlie => sheen::alpha(roughness),
+        }
+    }
+
+    /// Sample `i` of `samples` for `roughness` ([`ggx_sample`] or [`charlie_sample`]).
+    #[inline]
+    pub fn sample(self, i: u32, samples: u32, alpha: f32, src_size: u32, lod_bias: f32) -> Vec4 {
+        match self {
+            Lobe::Ggx => ggx_sample(i, samples, alpha, src_size, lod_bias),
+            Lobe::Charlie => charlie_sample(i, samples, alpha, src_size, lod_bias),
+        }
+    }
+
+    /// Whether a level of `roughness` is the source itself (GGX at roughness 0).
+    #[inline]
+    pub fn is_mirror(self, roughness: f32) -> bool {
+        self == Lobe::Ggx && roughness <= 0.0
+    }
+}
+
 /// Source level for a sample of density `pdf` out of `samples`, on a source cube of face
 /// size `src_size`: `½·log₂(Ωₛ/Ωₚ) + bias`, not clamped. An infinite `pdf` (a mirror-like
 /// lobe) gives `−∞`, a zero `pdf` gives `+∞`; callers clamp to the stored levels.
@@ -110,7 +152,7 @@ pub fn source_lod(pdf: f32, samples: u32, src_size: u32, bias: f32) -> f32 {
     0.5 * math::log2(ratio) + bias
 }
 
-/// Prefiltered radiance in direction `n` for perceptual `roughness`, from `samples` GGX
+/// GGX-prefiltered radiance in direction `n` for perceptual `roughness`, from `samples` GGX
 /// samples over the source cube `src`, source levels chosen with `lod_bias`: [`accumulate`]
 /// over chunks of `math::CHUNK` samples, then the weighted mean.
 pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, samples: u32, lod_bias: f32) -> Vec4 {
@@ -118,6 +160,12 @@ pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, 
     if alpha == 0.0 {
         return cubemap::sample_bilinear(src, layout, 0, sampling::normalize_or(n, Vec3::Z));
     }
+    sampled_dir(Lobe::Ggx, src, layout, n, roughness, samples, lod_bias)
+}
+
+/// The sampled mean of `lobe` in direction `n`: [`accumulate`] over chunks of
+/// `math::CHUNK` samples, then the weighted mean.
+pub fn sampled_dir(lobe: Lobe, src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, samples: u32, lod_bias: f32) -> Vec4 {
     let count = samples.max(1);
     // An explicit loop, not `MeanPartial::chunked`: the display's fragment shader calls
     // this (filtered sampling), and a closure holding the storage-buffer slice becomes a
@@ -126,55 +174,69 @@ pub fn prefilter_dir(src: &[Vec4], layout: CubeLayout, n: Vec3, roughness: f32, 
     let mut start = 0u32;
     while start < count {
         let c = if count - start < math::CHUNK { count - start } else { math::CHUNK };
-        p = accumulate(src, layout, n, roughness, count, start, c, lod_bias, p);
+        p = accumulate(lobe, src, layout, n, roughness, count, start, c, lod_bias, p);
         start += c;
     }
     p.resolve()
 }
 
 /// GGX sample `i` of `samples` for `alpha` (α = r²) in the tangent frame of the normal
-/// (`z` along it): the half vector (`xyz`), and in `w` the source level the sample reads,
+/// (`z` along it): the light direction `l = 2(n·h)h − n` of the half vector `h` (`xyz`,
+/// `z = n·l`), and in `w` the source level the sample reads,
 /// from its density `D(h)·(n·h) / (4·(v·h)) = D(h)/4` at `v = n` ([`source_lod`]; Karis
 /// 2013, with the filtered importance sampling of Křivánek & Colbert 2008). It depends on
 /// no texel: the GPU computes it per sample, the CPU backend once per level
-/// ([`ggx_samples`]) and reads it back ([`accumulate_samples`]), the same values.
+/// ([`lobe_samples`]) and reads it back ([`accumulate_samples`]), the same values.
 #[inline]
 pub fn ggx_sample(i: u32, samples: u32, alpha: f32, src_size: u32, lod_bias: f32) -> Vec4 {
     let ht = sampling::sample_ggx_tangent(sampling::hammersley(i, samples), alpha);
     let pdf = 0.25 * microfacet::d_ggx(ht.z, alpha);
-    ht.extend(source_lod(pdf, samples, src_size, lod_bias))
+    let lt = ht * (2.0 * ht.z) - Vec3::Z;
+    lt.extend(source_lod(pdf, samples, src_size, lod_bias))
 }
 
-/// [`ggx_sample`] for every sample of a level of `roughness` with `samples` samples.
+/// Charlie sample `i` of `samples` for the sheen width `alpha`, as [`ggx_sample`]: the light
+/// direction in the normal's tangent frame, drawn from the whole weight `D(h)·(n·l)`
+/// (`sheen::charlie_light_sample`: every sample above the horizon, all of equal weight),
+/// and its source level. The point is `(radical inverse of i, (i + ½)/N)`: the second
+/// coordinate (stratified, never 0 or 1) for `n·l`, the first for the azimuth.
+#[inline]
+pub fn charlie_sample(i: u32, samples: u32, alpha: f32, src_size: u32, lod_bias: f32) -> Vec4 {
+    let xi = Vec2::new(sampling::radical_inverse(i), (i as f32 + 0.5) / samples as f32);
+    let s = sheen::charlie_light_sample(xi, alpha);
+    s.truncate().extend(source_lod(s.w, samples, src_size, lod_bias))
+}
+
+/// [`Lobe::sample`] for every sample of a level of `roughness` with `samples` samples.
 #[cfg(not(target_arch = "spirv"))]
-pub fn ggx_samples(samples: u32, roughness: f32, src_size: u32, lod_bias: f32) -> impl Iterator<Item = Vec4> {
+pub fn lobe_samples(lobe: Lobe, samples: u32, roughness: f32, src_size: u32, lod_bias: f32) -> impl Iterator<Item = Vec4> {
     let total = samples.max(1);
-    let alpha = alpha_from_roughness(math::saturate(roughness));
-    (0..total).map(move |i| ggx_sample(i, total, alpha, src_size, lod_bias))
+    let alpha = lobe.alpha(roughness);
+    (0..total).map(move |i| lobe.sample(i, total, alpha, src_size, lod_bias))
 }
 
-/// Adds GGX sample `g` ([`ggx_sample`]) around the unit normal `n` with tangent frame
-/// `(t, b)` to the sums: the light direction `l = 2(n·h)h − n` weighted by `n·l/N`, read
-/// trilinearly at the sample's source level.
+/// Adds sample `g` ([`ggx_sample`], [`charlie_sample`]) around the unit normal `n` with
+/// tangent frame `(t, b)` to the sums: its light direction `l` weighted by `n·l/N` where
+/// `cosine` (GGX's samples follow `D(h)` alone; `n·l` is the tangent frame's `z`), else by
+/// `1/N` (Charlie's follow the whole weight), read trilinearly at the sample's source level.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn add_sample(src: &[Vec4], layout: CubeLayout, n: Vec3, t: Vec3, b: Vec3, g: Vec4, inv_count: f32, acc: &mut math::CompensatedSum4, wsum: &mut math::CompensatedSum) {
-    let h = t * g.x + b * g.y + n * g.z;
-    let l = h * (2.0 * g.z) - n;
-    let n_dot_l = n.dot(l);
+fn add_sample(src: &[Vec4], layout: CubeLayout, n: Vec3, t: Vec3, b: Vec3, g: Vec4, cosine: bool, inv_count: f32, acc: &mut math::CompensatedSum4, wsum: &mut math::CompensatedSum) {
+    let l = t * g.x + b * g.y + n * g.z;
+    let n_dot_l = g.z;
     if n_dot_l > 0.0 {
-        let w = n_dot_l * inv_count;
+        let w = if cosine { n_dot_l * inv_count } else { inv_count };
         acc.add(cubemap::sample_lod(src, layout, l, g.w) * w);
         wsum.add(w);
     }
 }
 
 /// Adds samples `start .. start + count` of `total` around `n` to `p`, sample `i` being
-/// `sample(i)` ([`ggx_sample`]'s form): the sums both [`accumulate`] and
+/// `sample(i)` ([`Lobe::sample`]'s form): the sums both [`accumulate`] and
 /// [`accumulate_samples`] run.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn accumulate_with(src: &[Vec4], layout: CubeLayout, n: Vec3, total: u32, start: u32, count: u32, p: MeanPartial, sample: impl Fn(u32) -> Vec4) -> MeanPartial {
+fn accumulate_with(src: &[Vec4], layout: CubeLayout, n: Vec3, cosine: bool, total: u32, start: u32, count: u32, p: MeanPartial, sample: impl Fn(u32) -> Vec4) -> MeanPartial {
     // A zero or non-finite direction is read as +z rather than turned into NaN.
     let n = sampling::normalize_or(n, Vec3::Z);
     // Weights n·l/N sum to at most 1: no overflow, whatever the radiance.
@@ -185,7 +247,7 @@ fn accumulate_with(src: &[Vec4], layout: CubeLayout, n: Vec3, total: u32, start:
     let mut i = start;
     let end = start + count;
     while i < end {
-        add_sample(src, layout, n, t, b, sample(i), inv_count, &mut acc, &mut wsum);
+        add_sample(src, layout, n, t, b, sample(i), cosine, inv_count, &mut acc, &mut wsum);
         i += 1;
     }
     let (sum, carry) = acc.parts();
@@ -193,9 +255,10 @@ fn accumulate_with(src: &[Vec4], layout: CubeLayout, n: Vec3, total: u32, start:
     MeanPartial { sum, carry, weight: Vec4::new(w, wc, 0.0, 0.0) }
 }
 
-/// Adds GGX samples `start .. start + count` (of `samples` in all) around `n` to `p`.
+/// Adds samples `start .. start + count` (of `samples` in all) of `lobe` around `n` to `p`.
 #[allow(clippy::too_many_arguments)]
 pub fn accumulate(
+    lobe: Lobe,
     src: &[Vec4],
     layout: CubeLayout,
     n: Vec3,
@@ -206,24 +269,25 @@ pub fn accumulate(
     lod_bias: f32,
     p: MeanPartial,
 ) -> MeanPartial {
-    let alpha = alpha_from_roughness(math::saturate(roughness));
+    let alpha = lobe.alpha(roughness);
     let total = samples.max(1);
     let size = layout.size;
-    accumulate_with(src, layout, n, total, start, count, p, |i| ggx_sample(i, total, alpha, size, lod_bias))
+    accumulate_with(src, layout, n, lobe == Lobe::Ggx, total, start, count, p, |i| lobe.sample(i, total, alpha, size, lod_bias))
 }
 
-/// [`accumulate`] with the samples read from `table` (all of them, [`ggx_samples`]) instead
+/// [`accumulate`] with the samples read from `table` (all of them, [`lobe_samples`]) instead
 /// of made per texel: the same values.
 #[cfg(not(target_arch = "spirv"))]
-pub fn accumulate_samples(src: &[Vec4], layout: CubeLayout, n: Vec3, table: &[Vec4], start: u32, count: u32, p: MeanPartial) -> MeanPartial {
-    accumulate_with(src, layout, n, table.len() as u32, start, count, p, |i| table[i as usize])
+#[allow(clippy::too_many_arguments)]
+pub fn accumulate_samples(lobe: Lobe, src: &[Vec4], layout: CubeLayout, n: Vec3, table: &[Vec4], start: u32, count: u32, p: MeanPartial) -> MeanPartial {
+    accumulate_with(src, layout, n, lobe == Lobe::Ggx, table.len() as u32, start, count, p, |i| table[i as usize])
 }
 
-/// [`prefilter_dir`] from a table of its samples ([`ggx_samples`] of a non-zero roughness):
+/// [`prefilter_dir`] from a table of its samples ([`lobe_samples`] of a non-zero roughness):
 /// the same values, without making the samples again for every texel.
 #[cfg(not(target_arch = "spirv"))]
-pub fn prefilter_dir_samples(src: &[Vec4], layout: CubeLayout, n: Vec3, table: &[Vec4]) -> Vec4 {
-    MeanPartial::chunked(table.len().max(1) as u32, |start, c, p| accumulate_samples(src, layout, n, table, start, c, p))
+pub fn prefilter_dir_samples(lobe: Lobe, src: &[Vec4], layout: CubeLayout, n: Vec3, table: &[Vec4]) -> Vec4 {
+    MeanPartial::chunked(table.len().max(1) as u32, |start, c, p| accumulate_samples(lobe, src, layout, n, table, start, c, p))
 }
 
 /// At roughness 0 (a mirror) a `dst_size`-wide level is the source level of that size, bit
@@ -240,12 +304,12 @@ pub fn mirror_level(layout: CubeLayout, dst_size: u32) -> u32 {
     SAMPLED
 }
 
-/// Texel `(x, y)` of `face` of a `dst_size`-wide output level for `roughness`: the source
-/// texel itself at roughness 0 ([`mirror_level`]), the exact sum over source level
-/// `exact_level` ([`exact_dir`]) unless that is [`SAMPLED`], else [`prefilter_dir`] at the
-/// texel centre.
+/// Texel `(x, y)` of `face` of a `dst_size`-wide output level of `lobe` for `roughness`:
+/// [`mirror_texel`] for a GGX mirror, the exact sum over source level `exact_level`
+/// ([`exact_dir`]) unless that is [`SAMPLED`], else the sampled mean at the texel centre.
 #[allow(clippy::too_many_arguments)]
 pub fn prefilter_texel(
+    lobe: Lobe,
     src: &[Vec4],
     layout: CubeLayout,
     face: u32,
@@ -257,53 +321,67 @@ pub fn prefilter_texel(
     lod_bias: f32,
     exact_level: u32,
 ) -> Vec4 {
-    if roughness <= 0.0 {
-        let level = mirror_level(layout, dst_size);
-        if level != SAMPLED {
-            return src[layout.index(level, face, x, y) as usize];
-        }
+    if lobe.is_mirror(roughness) {
+        return mirror_texel(src, layout, face, x, y, dst_size);
     }
     let n = cubemap::texel_dir(face, x, y, dst_size);
     if exact_level != SAMPLED {
-        return exact_dir(src, layout, exact_level, n, roughness);
+        return exact_dir(lobe, src, layout, exact_level, n, roughness);
     }
-    prefilter_dir(src, layout, n, roughness, samples, lod_bias)
+    sampled_dir(lobe, src, layout, n, roughness, samples, lod_bias)
+}
+
+/// Texel `(x, y)` of `face` of a `dst_size`-wide level of a GGX mirror (roughness 0): the
+/// source texel itself, bit for bit, where the source has a level of that size
+/// ([`mirror_level`]), else the source read bilinearly along the texel's direction.
+pub fn mirror_texel(src: &[Vec4], layout: CubeLayout, face: u32, x: u32, y: u32, dst_size: u32) -> Vec4 {
+    let level = mirror_level(layout, dst_size);
+    if level != SAMPLED {
+        return src[layout.index(level, face, x, y) as usize];
+    }
+    cubemap::sample_bilinear(src, layout, 0, cubemap::texel_dir(face, x, y, dst_size))
 }
 
 /// `PrefilterParams::exact_level` of a level that is sampled, not summed exactly.
 pub const SAMPLED: u32 = u32::MAX;
 
-/// Face size of the source level an exact sum for `roughness` runs over: the smallest power
-/// of two whose texel (`π/(2t)` radians) is at most `α/8`, at most `src_size` (at `α/4` a
-/// texel-wide sun moved to its coarse texel's centre still shifted `r = 1` by 10 % on
-/// city.exr).
+/// Face size of the source level an exact sum of `lobe` for `roughness` runs over: the
+/// smallest power of two whose texel (`π/(2t)` radians) is at most an eighth of the lobe's
+/// width, at most `src_size`. GGX's width is `α` (at `α/4` a texel-wide sun moved to its
+/// coarse texel's centre still shifted `r = 1` by 10 % on city.exr); Charlie's is its
+/// ring's ([`sheen::charlie_ring_width`]).
 #[inline]
-pub fn exact_source_size(roughness: f32, src_size: u32) -> u32 {
-    let alpha = alpha_from_roughness(math::saturate(roughness));
+pub fn exact_source_size(lobe: Lobe, roughness: f32, src_size: u32) -> u32 {
+    let alpha = lobe.alpha(roughness);
+    let width = match lobe {
+        Lobe::Ggx => alpha,
+        Lobe::Charlie => sheen::charlie_ring_width(alpha),
+    };
     let mut t = 1u32;
-    while t < src_size && math::PI / (2.0 * t as f32) > 0.125 * alpha {
+    while t < src_size && math::PI / (2.0 * t as f32) > 0.125 * width {
         t *= 2;
     }
     t
 }
 
-/// Whether a level of `roughness` with `samples` GGX samples per texel is cheaper summed
-/// exactly over [`exact_source_size`] (`6t²` terms) than sampled (about 8 terms a sample).
+/// Whether a level of `lobe` for `roughness` with `samples` samples per texel is cheaper
+/// summed exactly over [`exact_source_size`] (`6t²` terms) than sampled (about 8 terms a
+/// sample).
 #[inline]
-pub fn prefers_exact(roughness: f32, samples: u32, src_size: u32) -> bool {
-    let t = exact_source_size(roughness, src_size);
+pub fn prefers_exact(lobe: Lobe, roughness: f32, samples: u32, src_size: u32) -> bool {
+    let t = exact_source_size(lobe, roughness, src_size);
     roughness > 0.0 && 6 * t * t <= 8 * samples
 }
 
-/// The source level (of `layout`) that a level of `roughness` with `samples` GGX samples
-/// per texel is summed over exactly, or [`SAMPLED`] where sampling is cheaper
+/// The source level (of `layout`) that a level of `lobe` for `roughness` with `samples`
+/// samples per texel is summed over exactly, or [`SAMPLED`] where sampling is cheaper
 /// ([`prefers_exact`]).
 #[inline]
-pub fn exact_level(roughness: f32, samples: u32, layout: CubeLayout) -> u32 {
-    if !prefers_exact(roughness, samples, layout.size) {
+pub fn exact_level(lobe: Lobe, roughness: f32, samples: u32, layout: CubeLayout) -> u32 {
+    if !prefers_exact(lobe, roughness, samples, layout.size) {
         return SAMPLED;
     }
-    let t = exact_source_size(roughness, layout.size);
+    let t = exact_source_size(lobe, roughness, layout.size);
     let mut level = 0;
     while level + 1 < layout.levels && layout.level_size(level) > t {
         level += 1;
@@ -311,27 +389,35 @@ pub fn exact_level(roughness: f32, samples: u32, layout: CubeLayout) -> u32 {
     level
 }
 
-/// Adds texels `start .. start + count` of source level `level` to the exact GGX-weighted
-/// mean for direction `n` and `roughness` (see the module header).
-pub fn exact_accumulate(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
+/// Adds texels `start .. start + count` of source level `level` to the exact mean weighted
+/// by `lobe` for direction `n` and `roughness` (see the module header).
+#[allow(clippy::too_many_arguments)]
+pub fn exact_accumulate(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
     let n = sampling::normalize_or(n, Vec3::Z);
-    let alpha = alpha_from_roughness(math::saturate(roughness));
-    // D ≤ 1/(πα²) and Ω ≤ 4π/6: scaled by α² so no weight exceeds about 1.
+    let alpha = lobe.alpha(roughness);
+    // GGX: D ≤ 1/(πα²) and Ω ≤ 4π/6: scaled by α² so no weight exceeds about 1. Charlie:
+    // D scaled by its largest value over the hemisphere (`sheen::charlie_light_weight`).
     let scale = alpha * alpha;
+    let charlie = lobe == Lobe::Charlie;
     cubemap::weighted_level_sum(src, layout, level, cubemap::INLINE_GEOMETRY, start, count, p, |l, omega| {
         let n_dot_l = n.dot(l);
         if n_dot_l > 0.0 {
-            let h = sampling::normalize_or(n + l, n);
-            microfacet::d_ggx_vec(n, h, alpha) * scale * n_dot_l * omega
+            let d = if charlie {
+                sheen::charlie_light_weight(n_dot_l, alpha)
+            } else {
+                let h = sampling::normalize_or(n + l, n);
+                microfacet::d_ggx_vec(n, h, alpha) * scale
+            };
+            d * n_dot_l * omega
         } else {
             0.0
         }
     })
 }
 
-/// The exact GGX-weighted mean over every texel of `level` (see [`exact_accumulate`]),
+/// The exact `lobe`-weighted mean over every texel of `level` (see [`exact_accumulate`]),
 /// chunked as the GPU runs it.
-pub fn exact_dir(src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32) -> Vec4 {
+pub fn exact_dir(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32) -> Vec4 {
     let s = layout.level_size(level);
-    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| exact_accumulate(src, layout, level, n, roughness, start, c, p))
+    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| exact_accumulate(lobe, src, layout, level, n, roughness, start, c, p))
 }

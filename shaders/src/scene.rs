@@ -79,6 +79,11 @@ pub struct Frame {
     /// The grid's metalness from the top row to the bottom (`x`, `y`) and roughness from
     /// the left column to the right (`z`, `w`).
     pub grid_ranges: Vec4,
+    /// Sheen colour of the spheres (`xyz`, linear; black: no sheen).
+    pub sheen_color: Vec4,
+    /// The grid's sheen roughness from the left column to the right (`x`, `y`; `z`, `w`
+    /// unused).
+    pub sheen_ranges: Vec4,
 }
 
 impl Frame {
@@ -161,6 +166,8 @@ pub fn grid_material(frame: &Frame, row: u32, col: u32) -> Material {
         roughness: math::clamp(r.z + (r.w - r.z) * step(col, frame.columns), r.z, r.w),
         occlusion: 1.0,
         emissive: Vec3::ZERO,
+        sheen_color: frame.sheen_color.truncate(),
+        sheen_roughness: math::clamp(frame.sheen_ranges.x + (frame.sheen_ranges.y - frame.sheen_ranges.x) * step(col, frame.columns), frame.sheen_ranges.x, frame.sheen_ranges.y),
     }
 }
 
@@ -170,14 +177,32 @@ fn step(i: u32, n: u32) -> f32 {
     if n > 1 { i as f32 / (n - 1) as f32 } else { 0.0 }
 }
 
+/// The baked buffers a frame reads: the specular, irradiance, sheen and source cubes and
+/// the BRDF and sheen tables (storage buffers on the GPU; each a plain slice argument,
+/// since a struct holding storage-buffer slices does not validate in a shader).
+///
 /// Radiance leaving point `p` (normal `n`) towards the eye along `v` under the models and
-/// lights of `opts`: emission, the image-based light and every direct light of the frame.
+/// lights of `opts`: emission, the image-based light and every direct light of the frame,
+/// each with the material's sheen layer on top (`shade::sheen_ibl`, `shade::sheen_direct`).
 #[allow(clippy::too_many_arguments)]
-pub fn shade_point(frame: &Frame, opts: ShadeOptions, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], m: &Material, p: Vec3, n: Vec3, v: Vec3) -> Vec3 {
+pub fn shade_point(
+    frame: &Frame,
+    opts: ShadeOptions,
+    specular: &[Vec4],
+    irradiance: &[Vec4],
+    table: &[Vec2],
+    sheen: &[Vec4],
+    sheen_tables: &[Vec2],
+    m: &Material,
+    p: Vec3,
+    n: Vec3,
+    v: Vec3,
+) -> Vec3 {
     let mut color = m.emissive;
     if opts.flags & ShadeOptions::IBL != 0 {
         let s = shade::ibl_sample(frame.shape, specular, irradiance, table, opts, m, n, v);
-        color += shade::ibl(opts, m, n, v, s);
+        let (layer, keep) = shade::sheen_ibl(frame.shape, sheen, sheen_tables, m, n, v);
+        color += shade::ibl(opts, m, n, v, s) * keep + layer * m.occlusion;
     }
     if opts.flags & ShadeOptions::DIRECT != 0 {
         let count = if (frame.light_count as usize) < MAX_LIGHTS { frame.light_count as usize } else { MAX_LIGHTS };
@@ -191,7 +216,8 @@ pub fn shade_point(frame: &Frame, opts: ShadeOptions, specular: &[Vec4], irradia
                 let d2 = math::max(to.dot(to), 1e-8);
                 (to * (1.0 / math::sqrt(d2)), light.radiance.truncate() * (1.0 / d2))
             };
-            color += shade::direct(opts, m, n, v, l, radiance);
+            let (layer, keep) = shade::sheen_direct(frame.shape, sheen_tables, m, n, v, l, radiance);
+            color += shade::direct(opts, m, n, v, l, radiance) * keep + layer;
             i += 1;
         }
     }
@@ -200,7 +226,8 @@ pub fn shade_point(frame: &Frame, opts: ShadeOptions, specular: &[Vec4], irradia
 
 /// Linear radiance seen through pixel position `px` (a sphere of the grid, or the sky) and
 /// its depth in [0, 1] (1 for the sky).
-pub fn radiance_depth(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> (Vec3, f32) {
+#[allow(clippy::too_many_arguments)]
+pub fn radiance_depth(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], sheen: &[Vec4], sheen_tables: &[Vec2], px: Vec2) -> (Vec3, f32) {
     let origin = frame.eye.truncate();
     let dir = camera_ray(frame, px);
     if frame.flags & Frame::SPHERES != 0 {
@@ -211,15 +238,16 @@ pub fn radiance_depth(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradia
             let m = grid_material(frame, row, col);
             let d = (p - origin).dot(frame.forward.truncate());
             let depth = crate::surface::depth(d, frame.near, frame.far);
-            return (shade_point(frame, frame.options, specular, irradiance, table, &m, p, n, -dir), depth);
+            return (shade_point(frame, frame.options, specular, irradiance, table, sheen, sheen_tables, &m, p, n, -dir), depth);
         }
     }
     (sky(frame, source, specular, dir), 1.0)
 }
 
 /// Linear radiance seen through pixel position `px`.
-pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> Vec3 {
-    radiance_depth(frame, source, specular, irradiance, table, px).0
+#[allow(clippy::too_many_arguments)]
+pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], sheen: &[Vec4], sheen_tables: &[Vec2], px: Vec2) -> Vec3 {
+    radiance_depth(frame, source, specular, irradiance, table, sheen, sheen_tables, px).0
 }
 
 /// The sky along `dir`: the source cube when the blur is 0, else the specular cube at the
@@ -252,6 +280,7 @@ pub fn to_display(frame: &Frame, c: Vec3) -> Vec4 {
 }
 
 /// The value of pixel position `px`.
-pub fn pixel(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], px: Vec2) -> Vec4 {
-    to_display(frame, radiance(frame, source, specular, irradiance, table, px))
+#[allow(clippy::too_many_arguments)]
+pub fn pixel(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], sheen: &[Vec4], sheen_tables: &[Vec2], px: Vec2) -> Vec4 {
+    to_display(frame, radiance(frame, source, specular, irradiance, table, sheen, sheen_tables, px))
 }

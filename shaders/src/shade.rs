@@ -24,8 +24,11 @@
 //!
 //! Materials follow glTF 2.0's metallic–roughness model: `F₀ = mix(0.04, base, metallic)`,
 //! diffuse albedo `ρ = base·(1 − metallic)`.
+//!
+//! **Sheen** (`KHR_materials_sheen`, as the glTF Sample Viewer layers it): a Charlie lobe
+//! on top, `L_o = sheen + base·(1 − max(c)·E_C)` ([`sheen_ibl`], [`sheen_direct`]).
 
-use crate::brdf::{alpha_from_roughness, diffuse, fresnel, microfacet, phong};
+use crate::brdf::{alpha_from_roughness, diffuse, fresnel, microfacet, phong, sheen};
 use crate::cubemap::{self, CubeLayout};
 use crate::prefilter::RoughnessMapping;
 use crate::{lut, math, sampling};
@@ -187,9 +190,19 @@ pub struct Material {
     pub occlusion: f32,
     /// Emitted radiance.
     pub emissive: Vec3,
+    /// Sheen colour (`KHR_materials_sheen`; black: no sheen layer).
+    pub sheen_color: Vec3,
+    /// Perceptual sheen roughness in [0, 1] (`α = r²`).
+    pub sheen_roughness: f32,
 }
 
 impl Material {
+    /// Whether the material has a sheen layer (a sheen colour above black).
+    #[inline]
+    pub fn has_sheen(&self) -> bool {
+        self.sheen_color.max_element() > 0.0
+    }
+
     /// Normal-incidence reflectance `mix(0.04, base, metallic)`.
     #[inline]
     pub fn f0(&self) -> Vec3 {
@@ -296,6 +309,14 @@ pub struct EnvironmentShape {
     pub source_levels: u32,
     /// Mips of the irradiance cube (1: the display reads level 0).
     pub irradiance_levels: u32,
+    /// Face size of mip 0 of the sheen cube (a 1×1 stand-in where none was baked).
+    pub sheen_size: u32,
+    /// Mips of the sheen cube.
+    pub sheen_levels: u32,
+    /// `RoughnessMapping` code of the sheen mips (linear, as the glTF Sample Viewer reads).
+    pub sheen_mapping: u32,
+    /// Width of the sheen tables.
+    pub sheen_table_size: u32,
 }
 
 /// The direction the prefiltered cube is read along for normal `n`, mirror direction
@@ -572,3 +593,50 @@ pub fn multiple_scattering(f: Vec3, f0: Vec3, brdf: Vec2) -> (Vec3, Vec3) {
 /// The golden ratio's fractional part, `(√5 − 1)/2`: successive turns by it spread points
 /// evenly round a circle for any count (Vogel 1979's spiral).
 pub const GOLDEN: f32 = 0.618_034;
+
+/// The sheen layer of `KHR_materials_sheen` under the image-based light, as the glTF Sample
+/// Viewer shades it (`ibl.glsl`, `getIBLRadianceCharlie`; `pbr.frag`): the sheen cube read
+/// along the mirror direction at sheen roughness `r` (`lod = r·(M − 1)`, trilinear) times
+/// the sheen colour and the Charlie table `E_N(n·v, r)` (the sheen albedo with Neubelt's
+/// visibility; `lut::sheen_texel`), and the factor the layers under it keep,
+/// `1 − max(sheen colour)·E_C(n·v, r)` (the albedo with the Charlie visibility, Conty &
+/// Kulla 2017's albedo scaling). Returns `(sheen radiance, base-layer factor)`; no sheen
+/// gives `(0, 1)`.
+#[allow(clippy::too_many_arguments)]
+pub fn sheen_ibl(shape: EnvironmentShape, sheen: &[Vec4], tables: &[Vec2], m: &Material, n: Vec3, v: Vec3) -> (Vec3, f32) {
+    if !m.has_sheen() {
+        return (Vec3::ZERO, 1.0);
+    }
+    let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
+    let r = math::saturate(m.sheen_roughness);
+    let e = lut::sample(tables, shape.sheen_table_size, n_dot_v, r);
+    let dir = sampling::normalize_or(n * (2.0 * n.dot(v)) - v, n);
+    let layout = CubeLayout::new(shape.sheen_size, shape.sheen_levels);
+    let lod = RoughnessMapping::from_u32(shape.sheen_mapping).lod(r, shape.sheen_levels);
+    let light = cubemap::sample_lod(sheen, layout, dir, lod).truncate();
+    (light * m.sheen_color * e.x, 1.0 - m.sheen_color.max_element() * e.y)
+}
+
+/// The sheen layer under a direct light of `radiance` from `l`, as the glTF Sample Viewer
+/// shades it (`brdf.glsl`, `BRDF_specularSheen`; `pbr.frag`): `radiance·(n·l)·colour·D·V`
+/// with the Charlie `D` and its fitted visibility (`brdf::sheen`), and the factor the
+/// layers under it keep, `min(1 − max(colour)·E_C(n·v), 1 − max(colour)·E_C(n·l))`.
+/// Returns `(sheen radiance, base-layer factor)`; no sheen gives `(0, 1)`.
+pub fn sheen_direct(shape: EnvironmentShape, tables: &[Vec2], m: &Material, n: Vec3, v: Vec3, l: Vec3, radiance: Vec3) -> (Vec3, f32) {
+    if !m.has_sheen() {
+        return (Vec3::ZERO, 1.0);
+    }
+    let n_dot_l = n.dot(l);
+    let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
+    if n_dot_l <= 0.0 {
+        return (Vec3::ZERO, 1.0);
+    }
+    let r = math::saturate(m.sheen_roughness);
+    let alpha = sheen::alpha(r);
+    let h = sampling::normalize_or(l + v, n);
+    let f = sheen::d_charlie(n.dot(h), alpha) * sheen::v_charlie(n_dot_l, n_dot_v, alpha);
+    let peak = m.sheen_color.max_element();
+    let e_v = lut::sample(tables, shape.sheen_table_size, n_dot_v, r).y;
+    let e_l = lut::sample(tables, shape.sheen_table_size, n_dot_l, r).y;
+    (radiance * m.sheen_color * (f * n_dot_l), math::min(1.0 - peak * e_v, 1.0 - peak * e_l))
+}

@@ -5,7 +5,8 @@
 //! glTF 2.0 §3.9 (metallic–roughness material): base colour = factor × texture (sRGB
 //! texture, decoded to linear before filtering); metalness = factor × texture.B,
 //! roughness = factor × texture.G; occlusion `1 + strength·(texture.R − 1)`; emission =
-//! factor × texture (sRGB). Normal texture: tangent-space `n = normalize((2t − 1)·(s, s, 1))`,
+//! factor × texture (sRGB). `KHR_materials_sheen`: sheen colour = factor × texture.RGB
+//! (sRGB), sheen roughness = factor × texture.A. Normal texture: tangent-space `n = normalize((2t − 1)·(s, s, 1))`,
 //! mapped by the tangent frame `(T, B = w·(N × T), N)` (§3.9.3; Mikkelsen 2008).
 
 use crate::sampling;
@@ -30,6 +31,9 @@ pub struct MeshMaterial {
     pub ranges: Vec4,
     /// The shading models of this material.
     pub options: ShadeOptions,
+    /// `KHR_materials_sheen`: sheen colour factor (`xyz`, linear) and sheen roughness
+    /// factor (`w`).
+    pub sheen: Vec4,
 }
 
 impl MeshMaterial {
@@ -43,6 +47,10 @@ impl MeshMaterial {
     pub const OCCLUSION: u32 = 8;
     /// Emissive texture present.
     pub const EMISSIVE: u32 = 16;
+    /// Sheen colour texture present (`sheenColorTexture`, sRGB).
+    pub const SHEEN_COLOR: u32 = 32;
+    /// Sheen roughness texture present (`sheenRoughnessTexture`, alpha channel).
+    pub const SHEEN_ROUGHNESS: u32 = 64;
 }
 
 /// Texel values read at one point, one per texture slot (ignored where the slot is empty).
@@ -58,6 +66,10 @@ pub struct Texels {
     pub occlusion: Vec4,
     /// Emission (linear, decoded from sRGB).
     pub emissive: Vec4,
+    /// Sheen colour (linear, decoded from sRGB).
+    pub sheen_color: Vec4,
+    /// Sheen roughness in A.
+    pub sheen_roughness: Vec4,
 }
 
 #[inline]
@@ -76,6 +88,8 @@ pub fn material(m: &MeshMaterial, t: &Texels, normal: Vec3, tangent: Vec4) -> (M
     }
     let occlusion = if has(m, MeshMaterial::OCCLUSION) { 1.0 + m.params.z * (t.occlusion.x - 1.0) } else { 1.0 };
     let emissive = if has(m, MeshMaterial::EMISSIVE) { m.emissive.truncate() * t.emissive.truncate() } else { m.emissive.truncate() };
+    let sheen_color = if has(m, MeshMaterial::SHEEN_COLOR) { m.sheen.truncate() * t.sheen_color.truncate() } else { m.sheen.truncate() };
+    let sheen_roughness = if has(m, MeshMaterial::SHEEN_ROUGHNESS) { m.sheen.w * t.sheen_roughness.w } else { m.sheen.w };
     let n = sampling::normalize_or(normal, Vec3::Z);
     let shading_normal = if has(m, MeshMaterial::NORMAL) {
         let s = m.emissive.w;
@@ -96,6 +110,8 @@ pub fn material(m: &MeshMaterial, t: &Texels, normal: Vec3, tangent: Vec4) -> (M
             roughness: crate::math::clamp(roughness, m.ranges.x, m.ranges.y),
             occlusion,
             emissive,
+            sheen_color,
+            sheen_roughness: crate::math::saturate(sheen_roughness),
         },
         shading_normal,
     )

@@ -12,7 +12,7 @@ use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::shade::{self, IblSample, Material, ShadeOptions};
 
 fn metal(base: f32, roughness: f32) -> Material {
-    Material { base_color: Vec3::splat(base), metallic: 1.0, roughness, occlusion: 1.0, emissive: Vec3::ZERO }
+    Material { base_color: Vec3::splat(base), metallic: 1.0, roughness, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 }
 }
 
 /// A white furnace (prefiltered radiance and `E/π` both 1) seen by a white metal (`F₀ = 1`):

@@ -22,13 +22,17 @@ pub const DISPLAY_MESH_FS: EntryPoint = EntryPoint {
         Binding { group: 1, binding: 1, resource: Resource::Storage { read_only: true } },
         Binding { group: 1, binding: 2, resource: Resource::Storage { read_only: true } },
         Binding { group: 1, binding: 3, resource: Resource::Storage { read_only: true } },
+        Binding { group: 1, binding: 5, resource: Resource::Storage { read_only: true } },
+        Binding { group: 1, binding: 6, resource: Resource::Storage { read_only: true } },
         Binding { group: 2, binding: 0, resource: Resource::Uniform },
         Binding { group: 2, binding: 1, resource: Resource::Texture { dimension: Dimension::D2 } },
         Binding { group: 2, binding: 2, resource: Resource::Texture { dimension: Dimension::D2 } },
         Binding { group: 2, binding: 3, resource: Resource::Texture { dimension: Dimension::D2 } },
         Binding { group: 2, binding: 4, resource: Resource::Texture { dimension: Dimension::D2 } },
         Binding { group: 2, binding: 5, resource: Resource::Texture { dimension: Dimension::D2 } },
-        Binding { group: 2, binding: 6, resource: Resource::Sampler },
+        Binding { group: 2, binding: 6, resource: Resource::Texture { dimension: Dimension::D2 } },
+        Binding { group: 2, binding: 7, resource: Resource::Texture { dimension: Dimension::D2 } },
+        Binding { group: 2, binding: 8, resource: Resource::Sampler },
     ],
 };
 
@@ -53,6 +57,8 @@ pub const DISPLAY_SCENE_FS: EntryPoint = EntryPoint {
         Binding { group: 1, binding: 2, resource: Resource::Storage { read_only: true } },
         Binding { group: 1, binding: 3, resource: Resource::Storage { read_only: true } },
         Binding { group: 1, binding: 4, resource: Resource::Storage { read_only: true } },
+        Binding { group: 1, binding: 5, resource: Resource::Storage { read_only: true } },
+        Binding { group: 1, binding: 6, resource: Resource::Storage { read_only: true } },
     ],
 };
 

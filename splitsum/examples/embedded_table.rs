@@ -1,11 +1,18 @@
-//! Writes the BRDF table the library embeds (`splitsum::table`): the defaults' table,
-//! computed afresh on the CPU. `bash scripts/dev.sh table` runs it; `tests/lut.rs` checks
-//! that the committed file equals a fresh computation bit for bit.
+//! Writes the tables the library embeds (`splitsum::table`): the defaults' BRDF table and
+//! the sheen tables, computed afresh on the CPU. `bash scripts/dev.sh table` runs it;
+//! `tests/lut.rs` and `tests/sheen.rs` check that the committed files equal a fresh
+//! computation bit for bit.
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let path = std::env::args().nth(1).ok_or("usage: embedded_table PATH")?;
+    let mut args = std::env::args().skip(1);
+    let (Some(brdf), Some(sheen)) = (args.next(), args.next()) else {
+        return Err("usage: embedded_table BRDF_PATH SHEEN_PATH".into());
+    };
     let texels = splitsum::table::compute(splitsum::table::TableKey::EMBEDDED)?;
-    std::fs::write(&path, splitsum::table::encode(&texels))?;
-    println!("{path}: {} texels", texels.len());
+    std::fs::write(&brdf, splitsum::table::encode(&texels))?;
+    println!("{brdf}: {} texels", texels.len());
+    let texels = splitsum::table::compute_sheen();
+    std::fs::write(&sheen, splitsum::table::encode(&texels))?;
+    println!("{sheen}: {} texels", texels.len());
     Ok(())
 }

@@ -12,7 +12,7 @@ use crate::settings::{InputShape, Job, Products, Settings, Step};
 use crate::texture::{Cube, Lut, Sh9};
 use serde::Serialize;
 use splitsum_shaders::cubemap::{self, CubeLayout};
-use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_shaders::prefilter::{Lobe, RoughnessMapping};
 use splitsum_shaders::shade::EnvironmentShape;
 use web_time::Instant;
 
@@ -40,6 +40,12 @@ pub struct Made<C, L = C> {
     pub sh9: Option<Sh9>,
     /// The BRDF table, `(A, B, 0, 0)` per texel on a backend.
     pub lut: Option<L>,
+    /// The sheen cube (Charlie-prefiltered radiance; `Job::specular_layout`, sheen
+    /// roughness `Job::sheen_roughness_per_mip`).
+    pub sheen: Option<C>,
+    /// The sheen tables, `(Charlie table, sheen albedo, 0, 0)` per texel on a backend
+    /// (`crate::table::SHEEN_TABLE_SIZE`²).
+    pub sheen_tables: Option<L>,
     /// Wall time of each step.
     pub timings: Vec<Timing>,
 }
@@ -124,14 +130,7 @@ pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, job: &Job)
 pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout, job: &Job, estimates: &cost::Seconds, mut timings: Vec<Timing>) -> Result<Made<K::Texels>> {
     let p = job.products;
     let specular = if p.specular {
-        let pf = Prefilter {
-            layout: job.specular_layout(),
-            roughness: &job.roughness_per_mip,
-            levels: &job.levels,
-            samples: &job.samples_per_mip,
-            exact: &job.exact_levels,
-            lod_bias: job.lod_bias,
-        };
+        let pf = prefilter_of(job, Lobe::Ggx);
         Some(timed(k, &mut timings, Step::Specular, estimates, || k.prefilter(&source, source_layout, &pf))?)
     } else {
         None
@@ -148,7 +147,26 @@ pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout,
     } else {
         None
     };
-    Ok(Made { source: Some(source), specular, irradiance, sh9, lut, timings })
+    let (sheen, sheen_tables) = if p.sheen {
+        let pf = prefilter_of(job, Lobe::Charlie);
+        let cube = timed(k, &mut timings, Step::Sheen, estimates, || k.prefilter(&source, source_layout, &pf))?;
+        // Constants, as the BRDF table: computed once per process, then uploaded.
+        let tables = timed(k, &mut timings, Step::SheenTables, estimates, || k.upload("sheen tables", &crate::table::sheen_texels()))?;
+        (Some(cube), Some(tables))
+    } else {
+        (None, None)
+    };
+    Ok(Made { source: Some(source), specular, irradiance, sh9, lut, sheen, sheen_tables, timings })
+}
+
+/// What the prefilter of `job`'s `lobe` cube computes: the specular cube (GGX) or the
+/// sheen cube (Charlie), with the same layout and samples per mip.
+fn prefilter_of(job: &Job, lobe: Lobe) -> Prefilter<'_> {
+    let (roughness, levels, exact) = match lobe {
+        Lobe::Ggx => (&job.roughness_per_mip, &job.levels, &job.exact_levels),
+        Lobe::Charlie => (&job.sheen_roughness_per_mip, &job.sheen_levels, &job.sheen_exact_levels),
+    };
+    Prefilter { lobe, layout: job.specular_layout(), roughness, levels, samples: &job.samples_per_mip, exact, lod_bias: job.lod_bias }
 }
 
 /// Bakes `job` from `env` on backend `k`, leaving the products there.
@@ -168,6 +186,8 @@ pub fn read<K: Kernels>(k: &K, made: Made<K::Texels>, job: &Job) -> Result<Baked
         irradiance: made.irradiance.as_ref().map(|t| cube(job.irradiance_layout(), t)).transpose()?,
         sh9: made.sh9,
         lut: made.lut.as_ref().map(|t| -> Result<Lut> { Ok(Lut::from_texels(job.lut_size, &k.read(t)?)) }).transpose()?,
+        sheen: made.sheen.as_ref().map(|t| cube(job.specular_layout(), t)).transpose()?,
+        sheen_tables: made.sheen_tables.as_ref().map(|t| -> Result<Lut> { Ok(Lut::from_texels(crate::table::SHEEN_TABLE_SIZE, &k.read(t)?)) }).transpose()?,
         timings: made.timings,
     })
 }
@@ -189,6 +209,11 @@ pub fn empty_cube() -> Cube {
     Cube { layout: CubeLayout::new(1, 1), texels: vec![Default::default(); 6] }
 }
 
+/// A 1×1 table of zeros: the stand-in for a table a plan leaves out.
+pub fn empty_table() -> Lut {
+    Lut { size: 1, texels: vec![Default::default()] }
+}
+
 impl Baked {
     /// What a renderer reads, with stand-ins for the products not baked (nothing reads
     /// them) and the source cube's level 0 (the sharp sky).
@@ -198,14 +223,16 @@ impl Baked {
             source,
             specular: self.specular.unwrap_or_else(empty_cube),
             irradiance: self.irradiance.unwrap_or_else(empty_cube),
-            lut: self.lut.unwrap_or(Lut { size: 1, texels: vec![Default::default()] }),
+            lut: self.lut.unwrap_or_else(empty_table),
+            sheen: self.sheen.unwrap_or_else(empty_cube),
+            sheen_tables: self.sheen_tables.unwrap_or_else(empty_table),
             mapping,
         }
     }
 }
 
 /// What a renderer reads, in host memory: the sharp sky, the specular cube, the irradiance
-/// cube and the BRDF table.
+/// cube, the BRDF table, and the sheen cube and tables.
 #[derive(Clone)]
 pub struct BakedEnvironment {
     /// The source cube's level 0 (the sharp sky).
@@ -216,6 +243,11 @@ pub struct BakedEnvironment {
     pub irradiance: Cube,
     /// BRDF table.
     pub lut: Lut,
+    /// Sheen cube (a 1×1 stand-in where nothing reads it).
+    pub sheen: Cube,
+    /// Sheen tables (the Charlie table, the sheen albedo; a 1×1 stand-in where nothing
+    /// reads them).
+    pub sheen_tables: Lut,
     /// Roughness of the specular mips.
     pub mapping: RoughnessMapping,
 }
@@ -238,6 +270,10 @@ impl BakedEnvironment {
             source_size: self.source.layout.size,
             source_levels: 1,
             irradiance_levels: self.irradiance.layout.levels,
+            sheen_size: self.sheen.layout.size,
+            sheen_levels: self.sheen.layout.levels,
+            sheen_mapping: crate::settings::SHEEN_MAPPING as u32,
+            sheen_table_size: self.sheen_tables.size,
         }
     }
 }

@@ -20,7 +20,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Version of the entry format (part of every key).
-pub const FORMAT: &str = "splitsum-cache-2";
+pub const FORMAT: &str = "splitsum-cache-3";
 
 /// The cache folder: `$SPLITSUM_CACHE`, else `$XDG_CACHE_HOME/splitsum`, else
 /// `~/.cache/splitsum`, else `.splitsum-cache`.
@@ -63,7 +63,7 @@ struct Manifest {
 }
 
 /// The files of an entry, as [`Cache::put`] writes them: the only names the cache removes.
-const ENTRY_FILES: [&str; 5] = ["manifest.json", "source.bin", "specular.bin", "irradiance.bin", "lut.bin"];
+const ENTRY_FILES: [&str; 7] = ["manifest.json", "source.bin", "specular.bin", "irradiance.bin", "lut.bin", "sheen.bin", "sheen_tables.bin"];
 
 /// The largest entry manifest read (a real one is under a kilobyte).
 const MAX_MANIFEST_BYTES: u64 = 1 << 20;
@@ -213,14 +213,10 @@ impl Cache {
         let source = cube_from(&file("source.bin")?).ok_or_else(|| bad("source.bin"))?;
         let specular = cube_from(&file("specular.bin")?).ok_or_else(|| bad("specular.bin"))?;
         let irradiance = cube_from(&file("irradiance.bin")?).ok_or_else(|| bad("irradiance.bin"))?;
-        let lut_bytes = file("lut.bin")?;
-        let size = u32::from_le_bytes(lut_bytes.get(0..4).ok_or("lut.bin is empty")?.try_into().map_err(|_| "lut.bin")?);
-        let data = &lut_bytes[4..];
-        if size == 0 || data.len() != (size * size) as usize * 8 {
-            return Err("lut.bin does not hold a table".into());
-        }
-        let lut = Lut { size, texels: bytemuck::pod_collect_to_vec::<u8, Vec2>(data) };
-        Ok(BakedEnvironment { source, specular, irradiance, lut, mapping: RoughnessMapping::from_u32(m.mapping) })
+        let lut = table_from(&file("lut.bin")?).ok_or("lut.bin does not hold a table")?;
+        let sheen = cube_from(&file("sheen.bin")?).ok_or_else(|| bad("sheen.bin"))?;
+        let sheen_tables = table_from(&file("sheen_tables.bin")?).ok_or("sheen_tables.bin does not hold a table")?;
+        Ok(BakedEnvironment { source, specular, irradiance, lut, sheen, sheen_tables, mapping: RoughnessMapping::from_u32(m.mapping) })
     }
 
     /// Stores `env` under `key` (atomically: a temporary folder renamed into place).
@@ -229,14 +225,14 @@ impl Cache {
         let fail = |e: std::io::Error| Error::file(&self.dir, format!("cannot write the cache: {e}"));
         std::fs::create_dir_all(&tmp).map_err(fail)?;
         let mut files = BTreeMap::new();
-        let mut lut = env.lut.size.to_le_bytes().to_vec();
-        lut.extend_from_slice(bytemuck::cast_slice(&env.lut.texels));
         let source = env.source.levels(0, 0);
         for (name, bytes) in [
             ("source.bin", cube_bytes(&source)),
             ("specular.bin", cube_bytes(&env.specular)),
             ("irradiance.bin", cube_bytes(&env.irradiance)),
-            ("lut.bin", lut),
+            ("lut.bin", table_bytes(&env.lut)),
+            ("sheen.bin", cube_bytes(&env.sheen)),
+            ("sheen_tables.bin", table_bytes(&env.sheen_tables)),
         ] {
             std::fs::write(tmp.join(name), &bytes).map_err(fail)?;
             files.insert(name.to_string(), FileEntry { bytes: bytes.len() as u64, blake3: blake3::hash(&bytes).to_hex().to_string() });
@@ -254,4 +250,21 @@ impl Cache {
             fail(e)
         })
     }
+}
+
+/// A table as the cache stores it: its size (u32), then its texels.
+fn table_bytes(t: &Lut) -> Vec<u8> {
+    let mut out = t.size.to_le_bytes().to_vec();
+    out.extend_from_slice(bytemuck::cast_slice(&t.texels));
+    out
+}
+
+/// The table [`table_bytes`] wrote, if `bytes` hold one.
+fn table_from(bytes: &[u8]) -> Option<Lut> {
+    let size = u32::from_le_bytes(bytes.get(0..4)?.try_into().ok()?);
+    let data = &bytes[4..];
+    if size == 0 || data.len() != (size as usize).pow(2) * 8 {
+        return None;
+    }
+    Some(Lut { size, texels: bytemuck::pod_collect_to_vec::<u8, Vec2>(data) })
 }

@@ -26,7 +26,7 @@ pub struct Calibration {
 
 /// Nanoseconds per unit of work of each step on (lavapipe, CPU).
 #[derive(Clone, Copy, Debug, Serialize)]
-pub struct Rates(pub [(f64, f64); 5]);
+pub struct Rates(pub [(f64, f64); 7]);
 
 impl std::ops::Index<Step> for Rates {
     type Output = (f64, f64);
@@ -57,7 +57,9 @@ impl Default for Calibration {
             // basis functions, one weighted add each) is taken at an irradiance pair's rate.
             // A table other than the embedded one is integrated once per process on the CPU
             // (`crate::table`), 36 M evaluations in 0.33 s, whichever backend bakes.
-            ns: Rates([(28.0, 29.0), (25.0, 26.0), (3.7, 1.1), (3.7, 1.1), (9.1, 9.1)]),
+            // The sheen cube is taken at the specular cube's rate per sample (the same
+            // loop); its tables are embedded, uploaded like the BRDF table.
+            ns: Rates([(28.0, 29.0), (25.0, 26.0), (3.7, 1.1), (3.7, 1.1), (9.1, 9.1), (25.0, 26.0), (9.1, 9.1)]),
         }
     }
 }
@@ -151,7 +153,7 @@ impl Cost {
 
 /// A number per step of a bake (seconds, units of work), indexed by [`Step`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct PerStep(pub [f64; 5]);
+pub struct PerStep(pub [f64; 7]);
 
 /// Seconds of each step.
 pub type Seconds = PerStep;
@@ -177,7 +179,7 @@ impl PerStep {
 
     /// The step with the largest value.
     pub fn longest(&self) -> Step {
-        Step::ALL.into_iter().max_by(|a, b| self[*a].total_cmp(&self[*b])).expect("five steps")
+        Step::ALL.into_iter().max_by(|a, b| self[*a].total_cmp(&self[*b])).expect("seven steps")
     }
 }
 
@@ -192,23 +194,27 @@ fn work(job: &Job) -> (PerStep, u64) {
         work[Step::SourceCube] = 6.0 * (job.source_size as f64).powi(2) * (job.supersample as f64).powi(2);
     }
     bytes += source.texel_count() as u64 * 16;
-    if job.products.specular {
+    for cube in prefiltered_cubes(job) {
         let out = job.specular_layout();
-        for &l in &job.levels {
+        for &l in cube.levels {
             let texels = 6.0 * (out.level_size(l) as f64).powi(2);
-            let r = job.roughness_per_mip[l as usize];
-            if r > 0.0 {
+            let r = cube.roughness[l as usize];
+            if !cube.lobe.is_mirror(r) {
                 // An exact sum's 6t² terms cost about an eighth of a sample each.
-                let per_texel = if job.exact_levels[l as usize] != splitsum_shaders::prefilter::SAMPLED {
-                    6.0 * (source.level_size(job.exact_levels[l as usize]) as f64).powi(2) / 8.0
+                let per_texel = if cube.exact[l as usize] != splitsum_shaders::prefilter::SAMPLED {
+                    6.0 * (source.level_size(cube.exact[l as usize]) as f64).powi(2) / 8.0
                 } else {
                     job.samples_per_mip[l as usize] as f64
                 };
-                work[Step::Specular] += texels * per_texel;
+                work[cube.step] += texels * per_texel;
             }
             // The sums (3 × RGBA per texel) and the result.
             bytes += texels as u64 * 64;
         }
+    }
+    if job.products.sheen {
+        // The sheen tables are embedded (`crate::table`): uploaded, not integrated.
+        bytes += (crate::table::SHEEN_TABLE_SIZE as u64).pow(2) * 24;
     }
     if job.products.lut {
         // The embedded table is uploaded, not integrated (`crate::table`).
@@ -287,9 +293,9 @@ impl std::ops::AddAssign for Work {
 /// constant (`crate::table`): the defaults' is uploaded (its bytes only); another is
 /// integrated once per process, counted here as `lut::QUADRATURE_MEAN_EVALUATIONS` (or
 /// the samples) of about 60 operations per texel.
-pub fn step_work(job: &Job) -> [(Step, Work); 5] {
+pub fn step_work(job: &Job) -> [(Step, Work); 7] {
     let mut out = Step::ALL.map(|s| (s, Work::default()));
-    fn at(out: &mut [(Step, Work); 5], s: Step) -> &mut Work {
+    fn at(out: &mut [(Step, Work); 7], s: Step) -> &mut Work {
         &mut out.iter_mut().find(|(x, _)| *x == s).expect("every step").1
     }
     let source = job.source_layout();
@@ -306,16 +312,16 @@ pub fn step_work(job: &Job) -> [(Step, Work); 5] {
         w.flops += 20.0 * mips;
         w.bytes += 16.0 * (w.filtered_reads + source.texel_count() as f64);
     }
-    if job.products.specular {
-        let w = at(&mut out, Step::Specular);
+    for cube in prefiltered_cubes(job) {
+        let w = at(&mut out, cube.step);
         let layout = job.specular_layout();
-        for &l in &job.levels {
+        for &l in cube.levels {
             let texels = 6.0 * (layout.level_size(l) as f64).powi(2);
             let m = l as usize;
-            if job.roughness_per_mip[m] <= 0.0 {
+            if cube.lobe.is_mirror(cube.roughness[m]) {
                 w.filtered_reads += texels;
-            } else if job.exact_levels[m] != splitsum_shaders::prefilter::SAMPLED {
-                let terms = texels * 6.0 * (source.level_size(job.exact_levels[m]) as f64).powi(2);
+            } else if cube.exact[m] != splitsum_shaders::prefilter::SAMPLED {
+                let terms = texels * 6.0 * (source.level_size(cube.exact[m]) as f64).powi(2);
                 w.summed_reads += terms;
                 w.flops += 90.0 * terms;
             } else {
@@ -353,6 +359,32 @@ pub fn step_work(job: &Job) -> [(Step, Work); 5] {
             w.flops += 60.0 * texels * per_texel as f64;
         }
         w.bytes += 16.0 * texels;
+    }
+    if job.products.sheen {
+        let w = at(&mut out, Step::SheenTables);
+        w.bytes += 16.0 * (crate::table::SHEEN_TABLE_SIZE as f64).powi(2);
+    }
+    out
+}
+
+/// One prefiltered cube of a job, as the cost model walks it.
+struct PrefilteredCube<'a> {
+    step: Step,
+    lobe: splitsum_shaders::prefilter::Lobe,
+    levels: &'a [u32],
+    roughness: &'a [f32],
+    exact: &'a [u32],
+}
+
+/// The prefiltered cubes `job` bakes: the specular cube, the sheen cube.
+fn prefiltered_cubes(job: &Job) -> Vec<PrefilteredCube<'_>> {
+    use splitsum_shaders::prefilter::Lobe;
+    let mut out = Vec::new();
+    if job.products.specular {
+        out.push(PrefilteredCube { step: Step::Specular, lobe: Lobe::Ggx, levels: &job.levels, roughness: &job.roughness_per_mip, exact: &job.exact_levels });
+    }
+    if job.products.sheen {
+        out.push(PrefilteredCube { step: Step::Sheen, lobe: Lobe::Charlie, levels: &job.sheen_levels, roughness: &job.sheen_roughness_per_mip, exact: &job.sheen_exact_levels });
     }
     out
 }

@@ -114,11 +114,15 @@ pub enum Step {
     Sh9,
     /// The split-sum BRDF table.
     BrdfTable,
+    /// The Charlie-prefiltered sheen cube.
+    Sheen,
+    /// The sheen tables (the Charlie table and the sheen albedo).
+    SheenTables,
 }
 
 impl Step {
     /// Every step, in the order a bake runs them.
-    pub const ALL: [Step; 5] = [Step::SourceCube, Step::Specular, Step::Irradiance, Step::Sh9, Step::BrdfTable];
+    pub const ALL: [Step; 7] = [Step::SourceCube, Step::Specular, Step::Irradiance, Step::Sh9, Step::BrdfTable, Step::Sheen, Step::SheenTables];
 
     /// The step's name, as progress and timings show it.
     pub fn name(self) -> &'static str {
@@ -128,6 +132,8 @@ impl Step {
             Step::Irradiance => "irradiance",
             Step::Sh9 => "sh9",
             Step::BrdfTable => "brdf lut",
+            Step::Sheen => "sheen",
+            Step::SheenTables => "sheen tables",
         }
     }
 
@@ -139,6 +145,8 @@ impl Step {
             Step::Irradiance => &[Field::IrradianceSize, Field::IrradianceSource],
             Step::Sh9 => &[Field::ShSource],
             Step::BrdfTable => &[Field::LutSize, Field::LutSamples],
+            Step::Sheen => &[Field::Samples, Field::SampleGrowth, Field::Size],
+            Step::SheenTables => &[],
         }
     }
 }

@@ -245,6 +245,12 @@ pub fn lut_preview(lut: &Lut) -> Vec<u8> {
     lut.texels.iter().flat_map(|t| [to_u8(t.x), to_u8(t.y), 0]).collect()
 }
 
+/// One channel of a table (`channel(texel)`) as 8-bit RGB with the value in every channel
+/// (whichever channel a loader reads), values above 1 clamped to 1.
+pub fn table_channel_png(lut: &Lut, channel: impl Fn(splitsum_shaders::glam::Vec2) -> f32) -> Vec<u8> {
+    lut.texels.iter().flat_map(|t| [to_u8(channel(*t)); 3]).collect()
+}
+
 fn to_u8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
 }

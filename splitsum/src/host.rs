@@ -11,6 +11,7 @@ use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::kernels::ProbeParams;
+use splitsum_shaders::prefilter::Lobe;
 
 /// The BRDF table's arguments through the one validation, `Settings::validate`.
 fn check_lut_args(size: u32, samples: u32) -> Result<()> {
@@ -52,15 +53,17 @@ impl Backend {
     /// `roughness[m]` with `samples` GGX samples and source-level bias `lod_bias`.
     pub fn prefilter(&self, src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Result<Cube> {
         let all: Vec<u32> = (0..out.levels).collect();
-        self.prefilter_levels(src, out, roughness, &all, &vec![samples; out.levels as usize], false, lod_bias)
+        self.prefilter_levels(Lobe::Ggx, src, out, roughness, &all, &vec![samples; out.levels as usize], false, lod_bias)
     }
 
-    /// As [`Backend::prefilter`], baking only `levels`, level `m` from `samples[m]` GGX
-    /// samples, or with `exact` summed exactly over a source level where that is cheaper
+    /// As [`Backend::prefilter`] with the distribution `lobe` (GGX, or Charlie for the
+    /// sheen cube), baking only `levels`, level `m` from `samples[m]` samples, or with
+    /// `exact` summed exactly over a source level where that is cheaper
     /// (`prefilter::exact_level`).
     #[allow(clippy::too_many_arguments)]
     pub fn prefilter_levels(
         &self,
+        lobe: Lobe,
         src: &Cube,
         out: CubeLayout,
         roughness: &[f32],
@@ -72,8 +75,8 @@ impl Backend {
         if samples.contains(&0) {
             return Err(Error::setting(Field::Samples, "must be at least 1, not 0"));
         }
-        let exact = crate::settings::exact_levels(roughness, samples, exact, src.layout);
-        let job = Prefilter { layout: out, roughness, levels, samples, exact: &exact, lod_bias };
+        let exact = crate::settings::exact_levels(lobe, roughness, samples, exact, src.layout);
+        let job = Prefilter { lobe, layout: out, roughness, levels, samples, exact: &exact, lod_bias };
         with_kernels!(self, k => {
             let t = k.upload("source cube", &src.texels)?;
             Ok(Cube { layout: out, texels: k.read(&k.prefilter(&t, src.layout, &job)?)? })

@@ -256,6 +256,23 @@ pub fn write_into(dir: &Path, name: &str, baked: &Baked, job: &Job, about: About
             ])
         }));
     }
+    if let (Some(sheen), Some(tables)) = (&baked.sheen, &baked.sheen_tables) {
+        jobs.push(Box::new(move || {
+            let w = ktx2::write(&dir.join("sheen.ktx2"), sheen, job.format)?;
+            report_clamp("sheen.ktx2", &w);
+            files::write_lut_exr(&dir.join("sheen_tables.exr"), tables)?;
+            save_png("preview_sheen.png", &preview::mip_strip(sheen, 64))?;
+            Ok(vec![
+                file("sheen.ktx2", "Charlie-prefiltered radiance (sheen), mip m at sheen roughness m/(mips-1) (sheen_roughness_per_mip)".into(), Some(w)),
+                file(
+                    "sheen_tables.exr",
+                    "sheen tables: R = Charlie table (Neubelt visibility; the glTF Sample Viewer's lut_charlie), G = sheen albedo (Charlie visibility; lut_sheen_E); x = n·v, y = sheen roughness".into(),
+                    None,
+                ),
+                file("preview_sheen.png", "every sheen mip as a cross, sheen roughness rising to the right".into(), None),
+            ])
+        }));
+    }
     let files_out: Vec<OutputFile> = {
         use rayon::prelude::*;
         jobs.into_par_iter().map(|j| j()).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect()
@@ -278,9 +295,10 @@ fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
 /// written). The README cites the engine lines that load each.
 ///
 /// - `khronos`: `ggx/specular.ktx2` (RGBA16F, or RGBA32F past 65504 with format `auto`),
-///   `lambertian/diffuse.ktx2` (E/π), `lut_ggx.png` (8-bit, R = A, G = B, rows from
-///   roughness 0 at the top), the names and layout of the glTF Sample Viewer's
-///   environments (glTF-Sample-Environments) and glTF-IBL-Sampler's PNG table.
+///   `lambertian/diffuse.ktx2` (E/π), `charlie/sheen.ktx2`, `lut_ggx.png` (8-bit, R = A,
+///   G = B, rows from roughness 0 at the top), `lut_charlie.png` and `lut_sheen_E.png`
+///   (8-bit), the names and layout of the glTF Sample Viewer's environments
+///   (glTF-Sample-Environments) and its look-up tables.
 /// - `bevy`: `specular.ktx2`, `diffuse.ktx2` and `dfg.ktx2` (`R16G16_SFLOAT`, R = A,
 ///   G = B, Bevy's `DfgLut` layout), every one Zstandard-supercompressed as Bevy's own
 ///   environment maps.
@@ -318,6 +336,25 @@ pub fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> Result<
             if khronos {
                 files::write_png(&dir.join("lut_ggx.png"), lut.size, lut.size, &files::lut_preview(lut))?;
                 add("lut_ggx.png".into(), "split-sum table, height-correlated Smith: R = A, G = B (8-bit), x = n.v, y = roughness", None);
+                if let Some(sheen) = &baked.sheen {
+                    files::create_folder(&dir.join("charlie"))?;
+                    let w = ktx2::write_with(&dir.join("charlie/sheen.ktx2"), sheen, job.format, sc)?;
+                    report_clamp("charlie/sheen.ktx2", &w);
+                    add("charlie/sheen.ktx2".into(), "Charlie-prefiltered radiance (sheen), mip m at sheen roughness m/(mips-1)", Some(w));
+                    let t = baked.sheen_tables.as_ref().ok_or_else(|| missing("sheen tables"))?;
+                    files::write_png(&dir.join("lut_charlie.png"), t.size, t.size, &files::table_channel_png(t, |v| v.x))?;
+                    add(
+                        "lut_charlie.png".into(),
+                        "Charlie table (sheen albedo with Neubelt's visibility) in every channel (the viewer reads B), 8-bit, values above 1 written as 1; x = n.v, y = sheen roughness",
+                        None,
+                    );
+                    files::write_png(&dir.join("lut_sheen_E.png"), t.size, t.size, &files::table_channel_png(t, |v| v.y))?;
+                    add(
+                        "lut_sheen_E.png".into(),
+                        "sheen albedo with the Charlie visibility (albedo scaling) in every channel (the viewer reads R), 8-bit, values above 1 written as 1; x = n.v, y = sheen roughness",
+                        None,
+                    );
+                }
             } else {
                 ktx2::write_table(&dir.join("dfg.ktx2"), lut, sc)?;
                 add(
@@ -364,6 +401,7 @@ pub fn target_conventions(target: Target) -> &'static [&'static str] {
             "specular mip m holds perceptual roughness m/(mips-1) (alpha = roughness^2); mips = floor(log2(size)), down to 2x2",
             "diffuse values are E/pi",
             "BRDF table: height-correlated Smith (V_SmithGGXCorrelated), F = f0*A + B",
+            "khronos sheen: charlie/sheen.ktx2 mip m holds sheen roughness m/(mips-1) (alpha = roughness^2, Charlie distribution, v = n, weight D(h)(n.l)); lut_charlie.png = the sheen albedo with Neubelt's visibility, lut_sheen_E.png = with the Charlie visibility, both clamped to 1",
             "bevy: every KTX2 Zstandard-supercompressed; Bevy samples the cube at (x, y, -z) of its world direction",
         ],
         Target::Filament => &[
@@ -399,7 +437,7 @@ pub const DEFAULTS_ACCURACY: &str = "defaults (256² cube, 6 mips, geometric rou
 pub const CONVENTIONS: [&str; 5] = [
     "cube faces +X -X +Y -Y +Z -Z, Vulkan/KTX2 orientation (OpenGL 4.6 table 8.19)",
     "equirect: image centre looks down -Z, +Y up; u = 0.5 + atan2(x, -z)/2pi, v = polar angle/pi",
-    "specular mip m holds roughness roughness_per_mip[m] (alpha = roughness^2), GGX with n = v = r",
+    "specular mip m holds roughness roughness_per_mip[m] (alpha = roughness^2), GGX with n = v = r; sheen mip m holds sheen roughness sheen_roughness_per_mip[m], Charlie with n = v",
     "irradiance values are E/pi: a Lambert surface of albedo rho reflects rho times the value",
     "half-float overflow: values above 65504 are clamped and counted (format rgba16f) or kept in rgba32f (format auto)",
 ];

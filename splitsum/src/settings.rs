@@ -12,7 +12,7 @@ use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::equirect::Facing;
-use splitsum_shaders::prefilter::{self, RoughnessMapping};
+use splitsum_shaders::prefilter::{self, Lobe, RoughnessMapping};
 
 /// How the BRDF table is integrated.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -98,13 +98,17 @@ impl Target {
         }
     }
 
-    /// What the target's engine reads: Khronos and Bevy a specular and an irradiance cube
-    /// and the table; Filament the specular cube and SH9 (its table is built in).
+    /// What the target's engine reads: Khronos a specular, an irradiance and a sheen cube
+    /// and the tables (every folder of glTF-Sample-Environments has `charlie/sheen.ktx2`);
+    /// Bevy the same without sheen (Bevy shades no sheen); Filament the specular cube and
+    /// SH9 (its table, cloth's term included, is built in); splitsum everything but sheen,
+    /// which a bake adds when asked ([`Products::with_sheen`]).
     pub fn products(self) -> Products {
         match self {
-            Target::Splitsum => Products::ALL,
-            Target::Khronos | Target::Bevy => Products { specular: true, irradiance: true, sh9: false, lut: true },
-            Target::Filament => Products { specular: true, irradiance: false, sh9: true, lut: false },
+            Target::Splitsum => Products::STANDARD,
+            Target::Khronos => Products { sheen: true, ..Products::DISPLAY },
+            Target::Bevy => Products::DISPLAY,
+            Target::Filament => Products { specular: true, irradiance: false, sh9: true, lut: false, sheen: false },
         }
     }
 }
@@ -468,8 +472,15 @@ pub struct Job {
     pub format: Format,
     /// The specular levels baked (all, unless a plan keeps fewer; the others stay zero).
     pub levels: Vec<u32>,
+    /// The sheen levels baked (all, unless a plan keeps fewer; the others stay zero).
+    pub sheen_levels: Vec<u32>,
     /// Roughness of each specular mip.
     pub roughness_per_mip: Vec<f32>,
+    /// Sheen roughness of each mip of the sheen cube ([`SHEEN_MAPPING`]; it has the
+    /// specular cube's size and mips).
+    pub sheen_roughness_per_mip: Vec<f32>,
+    /// The source level each sheen mip is summed over exactly, or `prefilter::SAMPLED`.
+    pub sheen_exact_levels: Vec<u32>,
     /// GGX samples per texel of each specular mip (capped at [`MAX_SAMPLES`]).
     pub samples_per_mip: Vec<u32>,
     /// The source level each mip is summed over exactly, or `prefilter::SAMPLED`.
@@ -505,9 +516,12 @@ impl Job {
             lut_masking: v.lut_masking,
             format: given.format,
             levels: (0..v.mips).collect(),
+            sheen_levels: (0..v.mips).collect(),
             roughness_per_mip: (0..v.mips).map(|m| v.mapping.roughness(m, v.mips)).collect(),
+            sheen_roughness_per_mip: (0..v.mips).map(|m| SHEEN_MAPPING.roughness(m, v.mips)).collect(),
             samples_per_mip: Vec::new(),
             exact_levels: Vec::new(),
+            sheen_exact_levels: Vec::new(),
             supersample: match input {
                 InputShape::Equirect { width, .. } => splitsum_shaders::equirect::supersampling(v.source_size, width, given.supersample_density),
                 _ => 1,
@@ -515,7 +529,8 @@ impl Job {
             given,
         };
         job.samples_per_mip = job.asked_samples_per_mip().into_iter().map(|n| n.min(MAX_SAMPLES as u64) as u32).collect();
-        job.exact_levels = exact_levels(&job.roughness_per_mip, &job.samples_per_mip, job.exact_sums, job.source_layout());
+        job.exact_levels = exact_levels(Lobe::Ggx, &job.roughness_per_mip, &job.samples_per_mip, job.exact_sums, job.source_layout());
+        job.sheen_exact_levels = exact_levels(Lobe::Charlie, &job.sheen_roughness_per_mip, &job.samples_per_mip, job.exact_sums, job.source_layout());
         job
     }
 
@@ -526,6 +541,15 @@ impl Job {
             return Err(Error::setting(Field::Mips, format!("has no mip {m} to bake (there are {})", self.mips)));
         }
         self.levels = levels;
+        Ok(self)
+    }
+
+    /// This job baking only `levels` of the sheen cube (the others stay zero).
+    pub fn with_sheen_levels(mut self, levels: Vec<u32>) -> Result<Self> {
+        if let Some(&m) = levels.iter().find(|&&m| m >= self.mips) {
+            return Err(Error::setting(Field::Mips, format!("has no sheen mip {m} to bake (there are {})", self.mips)));
+        }
+        self.sheen_levels = levels;
         Ok(self)
     }
 
@@ -589,10 +613,16 @@ impl Job {
     }
 }
 
-/// The source level each specular level is summed over exactly, or `prefilter::SAMPLED`:
-/// with `exact`, wherever that costs less than its samples (`prefilter::exact_level`).
-pub fn exact_levels(roughness: &[f32], samples: &[u32], exact: bool, src: CubeLayout) -> Vec<u32> {
-    roughness.iter().zip(samples).map(|(&r, &n)| if exact { prefilter::exact_level(r, n, src) } else { prefilter::SAMPLED }).collect()
+/// How the sheen cube's mips map to sheen roughness, whatever the target: linear, as the
+/// glTF Sample Viewer reads it (`getIBLRadianceCharlie`: `lod = sheenRoughness ·
+/// (u_MipCount − 1)`) and glTF-IBL-Sampler writes it.
+pub const SHEEN_MAPPING: RoughnessMapping = RoughnessMapping::Linear;
+
+/// The source level each level of a `lobe` cube is summed over exactly, or
+/// `prefilter::SAMPLED`: with `exact`, wherever that costs less than its samples
+/// (`prefilter::exact_level`).
+pub fn exact_levels(lobe: Lobe, roughness: &[f32], samples: &[u32], exact: bool, src: CubeLayout) -> Vec<u32> {
+    roughness.iter().zip(samples).map(|(&r, &n)| if exact { prefilter::exact_level(lobe, r, n, src) } else { prefilter::SAMPLED }).collect()
 }
 
 /// The source level whose faces are `face` wide (or the smallest there is).
@@ -638,6 +668,8 @@ impl Unread {
 /// Which products to bake.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct Products {
+    /// The sheen cube (Charlie-prefiltered radiance) and the sheen tables.
+    pub sheen: bool,
     /// The prefiltered specular cube.
     pub specular: bool,
     /// The irradiance cube.
@@ -650,7 +682,15 @@ pub struct Products {
 
 impl Products {
     /// Everything.
-    pub const ALL: Products = Products { specular: true, irradiance: true, sh9: true, lut: true };
-    /// What a renderer reads: the specular cube, the irradiance cube and the BRDF table.
-    pub const DISPLAY: Products = Products { specular: true, irradiance: true, sh9: false, lut: true };
+    pub const ALL: Products = Products { specular: true, irradiance: true, sh9: true, lut: true, sheen: true };
+    /// Everything but sheen: splitsum's own folder unless sheen is asked for.
+    pub const STANDARD: Products = Products { sheen: false, ..Products::ALL };
+    /// What a renderer reads for materials without sheen: the specular cube, the
+    /// irradiance cube and the BRDF table.
+    pub const DISPLAY: Products = Products { specular: true, irradiance: true, sh9: false, lut: true, sheen: false };
+
+    /// These products, and the sheen cube and tables if `sheen`.
+    pub fn with_sheen(self, sheen: bool) -> Products {
+        Products { sheen: self.sheen || sheen, ..self }
+    }
 }

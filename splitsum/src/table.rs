@@ -6,7 +6,7 @@
 //! bytes equal a fresh computation bit for bit, and the tables' accuracy against the f64
 //! reference as before. On the GPU the table is uploaded, not recomputed, so the GPU's
 //! table is the CPU's exactly (the kernels stay for the report's and the tests' GPU-vs-CPU
-//! checks).
+//! checks). The sheen tables are constants too, embedded the same way.
 
 use crate::backend::Kernels;
 use crate::backend::cpu::Cpu;
@@ -60,7 +60,12 @@ pub fn compute(key: TableKey) -> Result<Vec<Vec4>> {
 
 /// The embedded table's texels, decoded.
 pub fn embedded() -> Vec<Vec4> {
-    EMBEDDED_BYTES
+    decode(EMBEDDED_BYTES)
+}
+
+/// Texels `(a, b, 0, 0)` from little-endian f32 pairs.
+fn decode(bytes: &[u8]) -> Vec<Vec4> {
+    bytes
         .chunks_exact(8)
         .map(|p| {
             let a = f32::from_le_bytes([p[0], p[1], p[2], p[3]]);
@@ -86,4 +91,25 @@ pub fn texels(key: TableKey) -> Result<Arc<Vec<Vec4>>> {
     let t = Arc::new(if key == TableKey::EMBEDDED { embedded() } else { compute(key)? });
     tables.insert(key, t.clone());
     Ok(t)
+}
+
+/// Texels per side of the sheen tables. Both are smooth in n·v and in roughness (no kink
+/// inside a texel); the glTF Sample Viewer samples them bilinearly.
+pub const SHEEN_TABLE_SIZE: u32 = 64;
+
+/// The sheen tables as `(Charlie table, sheen albedo)` little-endian f32 pairs per texel,
+/// written by `bash scripts/dev.sh table` (a fresh CPU computation takes 3 s on 2 cores).
+static SHEEN_BYTES: &[u8] = include_bytes!("../assets/sheen_tables_64.f32");
+
+/// The sheen tables computed afresh on the CPU: `(Charlie table, sheen albedo, 0, 0)` per
+/// texel of a [`SHEEN_TABLE_SIZE`]² table (`lut::sheen_texel`).
+pub fn compute_sheen() -> Vec<Vec4> {
+    Cpu.sheen_tables(SHEEN_TABLE_SIZE)
+}
+
+/// The sheen tables a bake uploads: the embedded ones, decoded once per process (`tests/sheen.rs`
+/// checks them bit for bit against [`compute_sheen`] and against the f64 reference).
+pub fn sheen_texels() -> Arc<Vec<Vec4>> {
+    static TABLE: OnceLock<Arc<Vec<Vec4>>> = OnceLock::new();
+    TABLE.get_or_init(|| Arc::new(decode(SHEEN_BYTES))).clone()
 }

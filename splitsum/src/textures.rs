@@ -487,6 +487,8 @@ impl Ibl {
             irradiance: Some(cube(&self.irradiance).await?),
             sh9: None,
             lut: Some(brdf),
+            sheen: None,
+            sheen_tables: None,
             timings: self.timings.clone(),
         })
     }

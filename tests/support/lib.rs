@@ -85,8 +85,8 @@ pub fn source_cube(name: &str, size: u32) -> splitsum::texture::Cube {
     Backend::Cpu.equirect_to_cube(&e, size, n, splitsum_shaders::equirect::Facing::NegZ).expect("cpu bake")
 }
 
-/// A small, quick bake of the courtyard for the display tests (32² specular cube with 4
-/// mips at 64 samples, 8² irradiance, 32² table), on the CPU.
+/// A small, quick bake of the courtyard for the display tests (32² specular and sheen
+/// cubes with 4 mips at 64 samples, 8² irradiance, 32² table, the sheen tables), on the CPU.
 pub fn small_display_bake() -> splitsum::bake::BakedEnvironment {
     let settings = splitsum::settings::Settings {
         size: 32,
@@ -101,7 +101,8 @@ pub fn small_display_bake() -> splitsum::bake::BakedEnvironment {
         ..splitsum::settings::Settings::default()
     };
     let env = splitsum::environment::Environment::Equirect(environment("courtyard"));
-    splitsum::bake::bake_for_display(&Backend::Cpu, &env, &settings).expect("cpu bake")
+    let job = settings.resolve(splitsum::InputShape::of(&env), splitsum::Products::DISPLAY.with_sheen(true)).expect("settings");
+    splitsum::bake::bake_job(&Backend::Cpu, &env, &job).expect("cpu bake").into_display(job.mapping)
 }
 
 /// A cube with full mips whose level 0 is `f(direction)` at the texel centres.

@@ -107,6 +107,12 @@ fn torus() -> (Vec<[f32; 3]>, Vec<[f32; 3]>, Vec<[f32; 4]>, Vec<[f32; 2]>, Vec<u
 
 /// The `.glb` bytes of the test model.
 pub fn sample_glb() -> Vec<u8> {
+    sample_glb_with(None)
+}
+
+/// The `.glb` bytes of the test model, its material carrying `extensions` (listed in
+/// `extensionsUsed`) where given.
+pub fn sample_glb_with(extensions: Option<serde_json::Value>) -> Vec<u8> {
     let (p, n, t, uv, idx) = torus();
     let mut bin: Vec<u8> = Vec::new();
     let mut views = Vec::new();
@@ -132,7 +138,7 @@ pub fn sample_glb() -> Vec<u8> {
         ([lo[0].min(q[0]), lo[1].min(q[1]), lo[2].min(q[2])], [hi[0].max(q[0]), hi[1].max(q[1]), hi[2].max(q[2])])
     });
     let count = p.len();
-    let json = serde_json::json!({
+    let mut json = serde_json::json!({
         "asset": {"version": "2.0", "generator": "splitsum tests/support/model.rs"},
         "scene": 0,
         "scenes": [{"nodes": [0]}],
@@ -165,6 +171,10 @@ pub fn sample_glb() -> Vec<u8> {
         "bufferViews": views,
         "buffers": [{"byteLength": bin.len()}]
     });
+    if let Some(ext) = extensions {
+        json["extensionsUsed"] = serde_json::Value::Array(ext.as_object().expect("extensions by name").keys().map(|k| serde_json::Value::String(k.clone())).collect());
+        json["materials"][0]["extensions"] = ext;
+    }
     glb(&json, &bin)
 }
 

@@ -32,6 +32,31 @@ pub(super) struct BakeArgs {
     /// instead of refusing the file.
     #[arg(long)]
     sanitize: bool,
+    /// Also bake the sheen products (`KHR_materials_sheen`): the Charlie-prefiltered cube
+    /// and the sheen tables (`sheen.ktx2`, `sheen_tables.exr`). The khronos target always
+    /// writes them (`charlie/sheen.ktx2`, `lut_charlie.png`, `lut_sheen_E.png`); bevy and
+    /// filament have no sheen files.
+    #[arg(long)]
+    sheen: bool,
+}
+
+/// What a bake writes: what the target's engine reads ([`splitsum::Target::products`]),
+/// and the sheen products with `--sheen` (refused where the target has no sheen files).
+fn products_of(settings: &splitsum::Settings, sheen: bool) -> anyhow::Result<splitsum::Products> {
+    let products = settings.target.products();
+    match settings.target {
+        splitsum::Target::Bevy | splitsum::Target::Filament if sheen => Err(Usage::new(format!(
+            "--sheen: the {} target has no sheen files ({})",
+            settings.target.name(),
+            if settings.target == splitsum::Target::Bevy {
+                "Bevy shades no sheen"
+            } else {
+                "Filament's cloth reads the specular cube and the cloth term of the DFG table built into the engine"
+            }
+        ))
+        .into()),
+        _ => Ok(products.with_sheen(sheen)),
+    }
 }
 
 pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
@@ -53,7 +78,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let env_path = args.env[0].clone();
     let mut settings = args.quality.settings();
     // An engine target bakes only what its engine reads.
-    let products = settings.target.products();
+    let products = products_of(&settings, args.sheen)?;
     // The flags are checked before anything is read or written.
     let source_size = settings.resolve(InputShape::Unknown, products)?.source_size;
     refuse_unread(given, &settings, products, env_path.is_dir())?;
@@ -131,7 +156,7 @@ fn write_bake(out: files::OutputDir, baked: &splitsum::Baked, job: &splitsum::Jo
 /// before anything is read; an environment that fails is reported and the others go on.
 fn batch_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
     let settings = args.quality.settings();
-    let products = settings.target.products();
+    let products = products_of(&settings, args.sheen)?;
     settings.resolve(InputShape::Unknown, products)?;
     refuse_unread(given, &settings, products, args.env.iter().all(|p| p.is_dir()))?;
     let mut names: std::collections::BTreeMap<String, &PathBuf> = Default::default();

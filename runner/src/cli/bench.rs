@@ -26,13 +26,18 @@ pub(super) struct BenchArgs {
     /// Run even if the bake is estimated to take over an hour.
     #[arg(long)]
     force: bool,
+    /// Bake the sheen cube and tables too (their steps timed and modelled like the others).
+    #[arg(long)]
+    sheen: bool,
 }
 
 pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let settings = args.quality.settings();
-    let source_size = settings.resolve(InputShape::Unknown, Products::ALL)?.source_size;
+    // What `runner bake` makes for this target, and the sheen products with `--sheen`.
+    let products = settings.target.products().with_sheen(args.sheen);
+    let source_size = settings.resolve(InputShape::Unknown, products)?.source_size;
     let (env, _) = load_input(&args.env, false, source_size)?;
-    let job = settings.resolve(InputShape::of(&env), Products::ALL)?;
+    let job = settings.resolve(InputShape::of(&env), products)?;
     println!(
         "bench: {} at size {}, {} mips ({:?}), {:?} samples per mip, irradiance {}² from {}², SH9 from {}², table {}",
         args.env.display(),
@@ -97,8 +102,8 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
             println!("  budget-to-error curve (predicted error: the built-in error model, end to end)");
             println!("  {:>9} {:>8} {:>11} {:>10} {:>11} {:>10}", "budget s", "samples", "irradiance", "error", "estimate s", "bake s");
             for &budget in &args.budgets {
-                let (chosen, error, estimate) = splitsum::cost::for_budget(&settings, InputShape::of(&env), Products::ALL, budget, &machine, &splitsum::cost::Calibration::default())?;
-                let job = chosen.resolve(InputShape::of(&env), Products::ALL)?;
+                let (chosen, error, estimate) = splitsum::cost::for_budget(&settings, InputShape::of(&env), products, budget, &machine, &splitsum::cost::Calibration::default())?;
+                let job = chosen.resolve(InputShape::of(&env), products)?;
                 let seconds: f64 = bake::bake_job(&backend, &env, &job)?.timings.iter().map(|t| t.seconds).sum();
                 println!("  {budget:>9} {:>8} {:>10}² {:>9.1} % {estimate:>11.3} {seconds:>10.3}", chosen.samples, job.irradiance_source, 100.0 * error);
             }

@@ -51,7 +51,7 @@ pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
     };
     let in_flags = |e| in_flags(e, &lut_flag);
     let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: args.masking, ..Settings::default() };
-    let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true };
+    let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true, sheen: false };
     let job = settings.resolve(crate::settings::InputShape::Unknown, only_table).map_err(in_flags)?;
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();

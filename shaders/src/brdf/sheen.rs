@@ -28,7 +28,7 @@
 //! `getSampleVector` for Charlie).
 
 use crate::math;
-use spirv_std::glam::{Vec2, Vec3};
+use spirv_std::glam::{Vec2, Vec3, Vec4};
 
 /// Sheen width `α = r²` of perceptual sheen roughness `r`, with `r` clamped to
 /// [10⁻⁶, 1] as the engines clamp it (at `r = 0` the lobe would be a delta at grazing).
@@ -103,6 +103,88 @@ pub fn sample_charlie_tangent(xi: Vec2, alpha: f32) -> Vec3 {
     let cos_t = math::sqrt(math::max(1.0 - sin_t * sin_t, 0.0));
     let (s, c) = math::sin_cos_turns(xi.x);
     Vec3::new(sin_t * c, sin_t * s, cos_t)
+}
+
+/// The sheen prefilter's lobe over light directions (glTF-IBL-Sampler's Charlie filter,
+/// `filter.frag`, with `v = n` as for GGX): the mean of the radiance weighted by
+/// `D(h)·(n·l)` over the hemisphere of `l`, `h` the half vector of `n` and `l`.
+///
+/// With `v = n`, `l = 2(n·h)h − n`, so `u = n·l = cos 2θ = 1 − 2 sin²θ` (θ the angle of `h`
+/// from `n`) and `D(h) ∝ (sin²θ)^k = ((1 − u)/2)^k`, `k = 1/(2α)`. The lobe is a ring
+/// about the horizon, not a cone about `n`: at small `α` it sits just above the horizon
+/// (its `u` has mean `2/(k + 2) = 4α/(1 + 4α)`) and at `α → 0` it is the horizon itself.
+///
+/// **Sampling.** glTF-IBL-Sampler draws `h` from `D(h)(n·h)` ([`sample_charlie_tangent`]),
+/// weighs each `l` by `n·l` and drops those below the horizon. In `t = sin²θ` that density is
+/// `(k + 1)·t^k`, and `n·l > 0` is `t < ½`, which holds for a share `2^−(k+1)` of the
+/// samples: 1/8 at `r = 0.5`, 1/90 at `r = 0.3`, one in 8000 at `r = 0.2`; below that its
+/// filter averages a handful of samples or none. splitsum draws `l` from the whole weight
+/// instead, so that every sample counts once: over `dω = du dφ` the weight is
+/// `u (1 − u)^k`, a Beta(2, b) density in `u` with `b = k + 1`, whose survival function is
+/// `S(u) = (1 − u)^b (1 + b u)`. With `1 − u = e^(−y/b)` (exact for any `b`, however large),
+/// `S = e^(−y)(1 + c)`, `c = b·u = b(1 − e^(−y/b))`, and `S = ξ` is solved for `y` by
+/// Newton's method on `f(y) = −y + ln(1 + c) − ln ξ`, `f′ = −1 + e^(−y/b)/(1 + c)` (`f` is
+/// concave and decreasing, and the start `y₀ = −ln ξ + √(−2 ln ξ)` lies right of the root,
+/// where Newton's steps fall monotonically onto it: `y₀ − ln(1 + y₀) ≥ −ln ξ` because
+/// `eˢ ≥ 1 + s + s²/2`). The density per solid angle, for the source level a sample reads:
+///
+/// ```text
+/// pdf(l) = u (1 − u)^k / (2π ∫₀¹ u (1 − u)^k du) = b(b + 1)/(2π) · u (1 − u)^(b−1)
+///        = (b + 1) · c · e^(−y) · e^(y/b) / (2π)
+/// ```
+///
+/// Returns `l` in the normal's tangent frame (`z = u > 0`) and, in `w`, its density.
+/// **Exact sums** weigh each texel by `D(h)·(n·l)·Ω` with `D` scaled by its largest value
+/// on the hemisphere, `(1 − n·l)^k` ([`charlie_light_weight`]): no underflow at `n·l = 0`
+/// however small `α`.
+#[inline]
+pub fn charlie_light_sample(xi: Vec2, alpha: f32) -> Vec4 {
+    let b = 1.0 + 0.5 / alpha;
+    // −ln ξ, ξ ∈ (0, 1).
+    let target = -math::log2(xi.y) * core::f32::consts::LN_2;
+    let mut y = target + math::sqrt(2.0 * target);
+    let mut i = 0;
+    while i < CHARLIE_NEWTON_STEPS {
+        let (c, e) = charlie_c(y, b);
+        let f = -y + math::ln_1p(c) + target;
+        let fp = -1.0 + e / (1.0 + c);
+        y = math::max(y - f / fp, 0.0);
+        i += 1;
+    }
+    let (c, e) = charlie_c(y, b);
+    let u = math::saturate(c / b);
+    let pdf = (b + 1.0) * c * math::exp2(-y * core::f32::consts::LOG2_E) / (e * math::TAU);
+    let sin_l = math::sqrt(math::max((1.0 - u) * (1.0 + u), 0.0));
+    let (s, co) = math::sin_cos_turns(xi.x);
+    Vec4::new(sin_l * co, sin_l * s, u, pdf)
+}
+
+/// Newton steps of [`charlie_light_sample`]: from its start, six reach the root to f32
+/// precision for every `ξ` ≥ 2⁻²⁴ and `α` from 10⁻¹² to 1 (`shaders/tests/sheen.rs`).
+const CHARLIE_NEWTON_STEPS: u32 = 6;
+
+/// `(c, e) = (b(1 − e^(−y/b)), e^(−y/b))` for [`charlie_light_sample`]: by its series where
+/// `y/b` is small (where `1 − e^(−z)` would lose every digit), relative error below 10⁻¹⁰.
+#[inline]
+fn charlie_c(y: f32, b: f32) -> (f32, f32) {
+    let z = y / b;
+    let e = math::exp2(-z * core::f32::consts::LOG2_E);
+    let c = if z < 1e-3 { y * (1.0 - z * (0.5 - z * (1.0 / 6.0))) } else { b * (1.0 - e) };
+    (c, e)
+}
+
+/// `D(h)` of the light direction at `n·l` (with `v = n`), divided by its largest value over
+/// `n·l ≥ 0`: `(1 − n·l)^(1/(2α))`, the exact sums' weight before `n·l·Ω`.
+#[inline]
+pub fn charlie_light_weight(n_dot_l: f32, alpha: f32) -> f32 {
+    math::pow(math::saturate(1.0 - n_dot_l), 0.5 / alpha)
+}
+
+/// The width, in `n·l` (about radians of elevation near the horizon), of the sheen
+/// prefilter's ring: its mean `n·l`, `4α/(1 + 4α)`.
+#[inline]
+pub fn charlie_ring_width(alpha: f32) -> f32 {
+    4.0 * alpha / (1.0 + 4.0 * alpha)
 }
 
 /// Which visibility term a sheen integral uses (see the module header for which engine
@@ -189,6 +271,10 @@ fn arc_piece(vis: SheenVisibility, nv: f32, sv: f32, alpha: f32, ta: f32, tb: f3
     }
     total
 }
+
+/// Evaluations of the integrand per [`albedo`]: the full-circle part's and the arc's.
+pub const ALBEDO_EVALUATIONS: u32 = FULL_PIECES * crate::quadrature::GAUSS_LEGENDRE_POINTS * FULL_AZIMUTHS
+    + (ARC_PIECES + 1) * crate::quadrature::GAUSS_LEGENDRE_POINTS * AZIMUTH_PIECES * crate::quadrature::GAUSS_LEGENDRE_POINTS;
 
 /// The directional albedo `E(n·v) = ∫ D(h)·V·(n·l) dω_l` of the sheen lobe (colour 1, no
 /// Fresnel) at perceptual sheen roughness `roughness`, by deterministic quadrature: the

@@ -7,7 +7,7 @@ use crate::progress::bar as progress;
 use crate::texture::{Equirect, Sh9};
 use indicatif::ProgressBar;
 use rayon::prelude::*;
-use splitsum_shaders::brdf::{self, microfacet::Masking};
+use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
 use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
@@ -64,6 +64,14 @@ pub fn equirect_pyramid(env: &Equirect) -> Vec<Vec4> {
         });
     }
     pyramid
+}
+
+impl Cpu {
+    /// The `size`² sheen tables, `(Charlie table, sheen albedo, 0, 0)` per texel
+    /// (`lut::sheen_texel`): constants, made on the CPU only (`crate::table`).
+    pub fn sheen_tables(&self, size: u32) -> Vec<Vec4> {
+        table("sheen tables", size, |x, y| lut::sheen_texel(x, y, size).extend(0.0).extend(0.0))
+    }
 }
 
 impl Kernels for Cpu {
@@ -126,12 +134,12 @@ impl Kernels for Cpu {
             let start = out.level_offset(m) as usize;
             let level = &mut texels[start..start + (FACES * s * s) as usize];
             let (r, n, e) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
-            if r > 0.0 && e == prefilter::SAMPLED && brdf::alpha_from_roughness(r) > 0.0 {
+            if e == prefilter::SAMPLED && !job.lobe.is_mirror(r) && job.lobe.alpha(r) > 0.0 {
                 // The samples depend on no texel: made once for the level.
-                let table: Vec<Vec4> = prefilter::ggx_samples(n, r, src_layout.size, job.lod_bias).collect();
-                fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_dir_samples(src, src_layout, cubemap::texel_dir(face, x, y, s), &table));
+                let table: Vec<Vec4> = prefilter::lobe_samples(job.lobe, n, r, src_layout.size, job.lod_bias).collect();
+                fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_dir_samples(job.lobe, src, src_layout, cubemap::texel_dir(face, x, y, s), &table));
             } else {
-                fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(src, src_layout, face, x, y, s, r, n, job.lod_bias, e));
+                fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(job.lobe, src, src_layout, face, x, y, s, r, n, job.lod_bias, e));
             }
         }
         bar.finish_and_clear();

@@ -771,8 +771,9 @@ impl Kernels for Gpu {
                 start: 0,
                 count: 0,
                 exact_level,
+                lobe: job.lobe as u32,
             };
-            if r <= 0.0 {
+            if job.lobe.is_mirror(r) {
                 // A mirror: the source read along each texel's direction, no sum.
                 self.run(&[Dispatch {
                     kernel: &spirv::KERNELS_PREFILTER_MIRROR,

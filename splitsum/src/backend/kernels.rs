@@ -8,6 +8,7 @@ use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::equirect::Facing;
 use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::kernels::ProbeParams;
+use splitsum_shaders::prefilter::Lobe;
 use splitsum_shaders::math::CHUNK;
 
 /// The chunks `(start, count)` a sum of `n` terms is split into (see `math::CHUNK`).
@@ -16,19 +17,21 @@ pub fn chunks(n: u32) -> impl Iterator<Item = (u32, u32)> {
     (0..n.div_ceil(CHUNK)).map(move |k| (k * CHUNK, CHUNK.min(n - k * CHUNK)))
 }
 
-/// What a prefilter computes: level `m` of `layout` filtered for `roughness[m]` from
-/// `samples[m]` GGX samples, or summed exactly over source level `exact[m]` unless that is
+/// What a prefilter computes: level `m` of `layout` filtered with `lobe` (GGX: the
+/// specular cube; Charlie: the sheen cube) for `roughness[m]` from `samples[m]` samples, or summed exactly over source level `exact[m]` unless that is
 /// `prefilter::SAMPLED`; only `levels` are baked (the others stay zero: a plan leaves out
 /// what nothing reads).
 #[derive(Clone, Debug)]
 pub struct Prefilter<'a> {
-    /// Layout of the specular cube.
+    /// The distribution.
+    pub lobe: Lobe,
+    /// Layout of the cube.
     pub layout: CubeLayout,
     /// Roughness of each level.
     pub roughness: &'a [f32],
     /// The levels baked.
     pub levels: &'a [u32],
-    /// GGX samples of each level.
+    /// Samples of each level.
     pub samples: &'a [u32],
     /// Source level summed exactly for each level, or `prefilter::SAMPLED`.
     pub exact: &'a [u32],
@@ -56,7 +59,7 @@ pub trait Kernels {
     fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Self::Texels>;
     /// Fills levels 1.. of `cube` from its level 0.
     fn build_mips(&self, cube: &mut Self::Texels, layout: CubeLayout) -> Result<()>;
-    /// The prefiltered specular cube of `job` from `src`.
+    /// The prefiltered cube of `job` (specular or sheen) from `src`.
     fn prefilter(&self, src: &Self::Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Self::Texels>;
     /// The irradiance cube (`E/π`) of faces of `size` from level `level` of `src`.
     fn irradiance(&self, src: &Self::Texels, src_layout: CubeLayout, level: u32, size: u32) -> Result<Self::Texels>;
