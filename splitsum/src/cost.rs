@@ -264,7 +264,8 @@ pub fn estimate(job: &Job, cal: &Calibration) -> Cost {
 /// an equirect area sample at least 4, a mip texel 4, a term of an exact sum 1).
 /// Floating-point operations are estimates, counted by reading the shared functions once:
 /// about 140 per GGX sample (the half vector ≈ 50, the lookup ≈ 70, the compensated sum
-/// ≈ 20), 80 per equirect area sample, 90 per term of an exact specular sum (texel
+/// ≈ 20; a Charlie sample ≈ 330, its three Newton steps ≈ 190 in place of the half vector's
+/// 50), 80 per equirect area sample, 90 per term of an exact specular sum (texel
 /// direction, solid angle, weight, compensated sum), 31 per irradiance term (its direction
 /// and solid angle read from a table: weight 7, compensated sums 24), 130 per SH9 texel. Bytes are the texels read and written (16 each).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -327,7 +328,7 @@ pub fn step_work(job: &Job) -> [(Step, Work); 7] {
             } else {
                 let samples = texels * job.samples_per_mip[m] as f64;
                 w.filtered_reads += 8.0 * samples;
-                w.flops += 140.0 * samples;
+                w.flops += if cube.lobe == splitsum_shaders::prefilter::Lobe::Charlie { 330.0 } else { 140.0 } * samples;
             }
             w.bytes += 16.0 * texels;
         }

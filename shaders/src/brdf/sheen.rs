@@ -159,9 +159,9 @@ pub fn charlie_light_sample(xi: Vec2, alpha: f32) -> Vec4 {
     Vec4::new(sin_l * co, sin_l * s, u, pdf)
 }
 
-/// Newton steps of [`charlie_light_sample`]: from its start, six reach the root to f32
+/// Newton steps of [`charlie_light_sample`]: from its start, three reach the root to f32
 /// precision for every `ξ` ≥ 2⁻²⁴ and `α` from 10⁻¹² to 1 (`shaders/tests/sheen.rs`).
-const CHARLIE_NEWTON_STEPS: u32 = 6;
+const CHARLIE_NEWTON_STEPS: u32 = 3;
 
 /// `(c, e) = (b(1 − e^(−y/b)), e^(−y/b))` for [`charlie_light_sample`]: by its series where
 /// `y/b` is small (where `1 − e^(−z)` would lose every digit), relative error below 10⁻¹⁰.
