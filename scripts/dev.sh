@@ -67,6 +67,16 @@ ensure_browser() {
     ensure_packages '/usr/bin/chromium:chromium'
 }
 
+# The glTF Sample Viewer's renderer and puppeteer-core (npm, into tests/viewer) for the test
+# that renders the khronos target's folder in it (tests/sample_viewer.rs, `dev.sh viewer`).
+ensure_viewer() {
+    ensure_packages '/usr/bin/node:nodejs' '/usr/bin/npm:npm'
+    if [ ! -d tests/viewer/node_modules/@khronosgroup/gltf-viewer ]; then
+        echo "dev.sh: installing the glTF Sample Viewer's renderer into tests/viewer (npm)" >&2
+        (cd tests/viewer && npm install --no-audit --no-fund --silent)
+    fi
+}
+
 # Mesa's llvmpipe behind EGL runs the GPU tests a second time on wgpu's GL backend.
 ensure_gl() {
     ensure_packages '/usr/lib/*/libEGL.so.1:libegl1' '/usr/lib/*/libEGL_mesa.so.0:libegl-mesa0' '/usr/lib/*/libGLESv2.so.2:libgles2' '/usr/lib/*/dri/swrast_dri.so:libgl1-mesa-dri'
@@ -169,6 +179,15 @@ case "$cmd" in
         done
         exec cargo +stable package --workspace --exclude splitsum-tests --exclude runner "$@"
         ;;
+    viewer)
+        # The khronos folder in the glTF Sample Viewer's renderer, headless (tests/sample_viewer.rs).
+        ensure_stable
+        ensure_vulkan
+        ensure_browser
+        ensure_peers
+        ensure_viewer
+        XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp} exec cargo +stable test --release -p splitsum-tests --test suite sample_viewer -- --ignored --nocapture "$@"
+        ;;
     table)
         # The tables the library embeds (splitsum/src/table.rs), computed afresh.
         ensure_stable
@@ -183,7 +202,7 @@ case "$cmd" in
         exec cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
         ;;
     *)
-        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | table | peers | environments" >&2
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | table | peers | environments | viewer" >&2
         exit 2
         ;;
 esac

@@ -17,6 +17,7 @@ mod portability;
 mod prefilter;
 mod render;
 mod report;
+mod sample_viewer;
 mod sheen;
 mod stability;
 mod targets;

