@@ -105,6 +105,36 @@ fn textures_baked_on_the_device_match_those_baked_on_the_cpu() {
     }
 }
 
+/// `Baker::bake_with_sheen`: the sheen cube and tables as textures on the application's
+/// device, on the GPU and on the CPU, read back: the sheen cube within 2 half-float ULPs of
+/// each other (as the other cubes above), and the tables equal to the embedded ones to half
+/// precision (2⁻¹¹ relative, the tables reach 1.8); `Baker::bake` makes no sheen.
+#[test]
+fn the_baker_makes_sheen_textures_when_asked() {
+    let (d, q) = device();
+    let env = splitsum::environment::embedded_default().unwrap();
+    let s = small();
+    let read = |compute| {
+        let ibl = Baker::new(d, q, compute).unwrap().bake_with_sheen(Source::Environment(&env), &s).unwrap();
+        let t = ibl.sheen.as_ref().expect("sheen textures");
+        assert_eq!((t.cube.mip_level_count(), t.roughness.len() as u32), (ibl.specular.mip_level_count(), ibl.specular.mip_level_count()));
+        ibl.read(d, q).unwrap()
+    };
+    let (gpu, cpu) = (read(Compute::Gpu), read(Compute::Cpu));
+    let (g, c) = (gpu.sheen.expect("read back"), cpu.sheen.expect("read back"));
+    let peak = c.texels.iter().map(|v| v.max_element()).fold(0.0f32, f32::max);
+    let worst = g.texels.iter().zip(&c.texels).map(|(x, y)| ((*x - *y).abs() / y.abs().max(Vec4::splat(1e-3 * peak))).max_element()).fold(0.0f32, f32::max);
+    eprintln!("sheen: GPU vs CPU textures, largest relative difference {worst:.2e}");
+    assert!(worst <= 2.0f32.powi(-10), "{worst:e}");
+    let embedded = splitsum::table::sheen_texels();
+    for tables in [gpu.sheen_tables.expect("read back"), cpu.sheen_tables.expect("read back")] {
+        for (t, e) in tables.texels.iter().zip(embedded.iter()) {
+            assert!((t.x - e.x).abs() <= 2.0f32.powi(-11) * e.x.max(1e-3) && (t.y - e.y).abs() <= 2.0f32.powi(-11) * e.y.max(1e-3), "{t} against {e}");
+        }
+    }
+    assert!(Baker::new(d, q, Compute::Cpu).unwrap().bake(Source::Environment(&env), &s).unwrap().sheen.is_none());
+}
+
 /// A half-float overflow: a sun of 10⁶ in a texel is clamped to 65504 in the halves, never
 /// ∞ (an ∞ would turn every filtered lookup that touches it into ∞ or NaN).
 #[test]

@@ -99,4 +99,4 @@ pub use splitsum_shaders::cubemap::CubeLayout;
 pub use splitsum_shaders::equirect::Facing;
 pub use splitsum_shaders::glam;
 pub use splitsum_shaders::prefilter::RoughnessMapping;
-pub use textures::{Baker, Compute, Ibl, IblViews, Source};
+pub use textures::{Baker, Compute, Ibl, IblViews, SheenTextures, Source};

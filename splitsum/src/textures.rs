@@ -48,6 +48,20 @@ pub enum Source<'a> {
     Texture(&'a wgpu::Texture),
 }
 
+/// The sheen products (`KHR_materials_sheen`) as textures on the caller's device.
+pub struct SheenTextures {
+    /// Charlie-prefiltered radiance: a cube of `Rgba16Float` with the specular cube's size
+    /// and mips, mip `m` at sheen roughness `roughness[m]` (`m/(mips − 1)`, read at
+    /// `lod = sheen roughness · (mips − 1)` as the glTF Sample Viewer reads it).
+    pub cube: wgpu::Texture,
+    /// The sheen tables, `Rg16Float`: the Charlie table (the sheen albedo with Neubelt's
+    /// visibility: sheen = cube · colour · R) and the sheen albedo with the Charlie
+    /// visibility (the layers below keep `1 − max(colour)·G`); x = n·v, y = sheen roughness.
+    pub tables: wgpu::Texture,
+    /// Sheen roughness of each mip.
+    pub roughness: Vec<f32>,
+}
+
 /// The baked products as textures on the caller's device.
 pub struct Ibl {
     /// Prefiltered specular radiance: a cube (six layers) of `Rgba16Float`, mip `m` at
@@ -63,6 +77,8 @@ pub struct Ibl {
     pub roughness: Vec<f32>,
     /// How roughness is spread over the mips (`roughness[m] = mapping.roughness(m, mips)`).
     pub mapping: RoughnessMapping,
+    /// The sheen products, where the bake made them ([`Baker::bake_with_sheen`]).
+    pub sheen: Option<SheenTextures>,
     /// Wall time of each step.
     pub timings: Vec<Timing>,
     /// The bake, resolved: every setting it used (what `output::write` records).
@@ -128,6 +144,15 @@ impl Baker {
     /// Bakes the specular cube, the irradiance cube and the BRDF table of `source` with
     /// `settings` (validated first) into textures on the baker's device.
     pub fn bake(&self, source: Source<'_>, settings: &Settings) -> Result<Ibl> {
+        self.bake_products(source, settings, false)
+    }
+
+    /// As [`Baker::bake`], and the sheen cube and tables too ([`Ibl::sheen`]).
+    pub fn bake_with_sheen(&self, source: Source<'_>, settings: &Settings) -> Result<Ibl> {
+        self.bake_products(source, settings, true)
+    }
+
+    fn bake_products(&self, source: Source<'_>, settings: &Settings, sheen: bool) -> Result<Ibl> {
         let shape = match source {
             Source::Environment(env) => InputShape::of(env),
             Source::Texture(t) => match texture_shape(t)? {
@@ -135,7 +160,7 @@ impl Baker {
                 Shape::Cube => InputShape::Cube { size: t.width() },
             },
         };
-        let job = settings.resolve(shape, Products::DISPLAY)?;
+        let job = settings.resolve(shape, Products::DISPLAY.with_sheen(sheen))?;
         match &self.gpu {
             Some(g) => {
                 let made = match source {
@@ -197,9 +222,35 @@ impl Baker {
         (cube("splitsum specular", job.size, job.mips), cube("splitsum irradiance", job.irradiance_size, 1), brdf)
     }
 
-    fn ibl(&self, job: &Job, textures: (wgpu::Texture, wgpu::Texture, wgpu::Texture), timings: Vec<Timing>) -> Ibl {
+    /// The sheen cube and tables of `job`, empty, where it bakes them.
+    fn sheen_textures(&self, job: &Job) -> Option<SheenTextures> {
+        if !job.products.sheen {
+            return None;
+        }
+        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
+        let texture = |label, size, layers, mips, format| {
+            self.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+                mip_level_count: mips,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let t = crate::table::SHEEN_TABLE_SIZE;
+        Some(SheenTextures {
+            cube: texture("splitsum sheen", job.size, FACES, job.mips, wgpu::TextureFormat::Rgba16Float),
+            tables: texture("splitsum sheen tables", t, 1, 1, wgpu::TextureFormat::Rg16Float),
+            roughness: job.sheen_roughness_per_mip.clone(),
+        })
+    }
+
+    fn ibl(&self, job: &Job, textures: (wgpu::Texture, wgpu::Texture, wgpu::Texture), sheen: Option<SheenTextures>, timings: Vec<Timing>) -> Ibl {
         let (specular, irradiance, brdf) = textures;
-        Ibl { specular, irradiance, brdf, roughness: job.roughness_per_mip.clone(), mapping: job.mapping, timings, job: job.clone() }
+        Ibl { specular, irradiance, brdf, roughness: job.roughness_per_mip.clone(), mapping: job.mapping, sheen, timings, job: job.clone() }
     }
 
     /// Packs the products on the device and copies them into the textures.
@@ -212,7 +263,14 @@ impl Baker {
         self.gpu_copy(g, spec, job.specular_layout(), FACES, 4, &textures.0)?;
         self.gpu_copy(g, irr, job.irradiance_layout(), FACES, 4, &textures.1)?;
         self.gpu_copy(g, lut, CubeLayout::new(job.lut_size, 1), 1, 2, &textures.2)?;
-        Ok(self.ibl(job, textures, made.timings))
+        let sheen = self.sheen_textures(job);
+        if let Some(t) = &sheen {
+            let cube = made.sheen.as_ref().ok_or_else(missing)?;
+            let tables = made.sheen_tables.as_ref().ok_or_else(missing)?;
+            self.gpu_copy(g, cube, job.specular_layout(), FACES, 4, &t.cube)?;
+            self.gpu_copy(g, tables, CubeLayout::new(crate::table::SHEEN_TABLE_SIZE, 1), 1, 2, &t.tables)?;
+        }
+        Ok(self.ibl(job, textures, sheen, made.timings))
     }
 
     /// Packs every level of `texels` (laid out as `layout` with `layers` layers) into
@@ -284,7 +342,13 @@ impl Baker {
         write(&textures.1, &irr.texels, irr.layout, FACES, 4);
         let table: Vec<Vec4> = lut.texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect();
         write(&textures.2, &table, CubeLayout::new(lut.size, 1), 1, 2);
-        self.ibl(job, textures, baked.timings.clone())
+        let sheen = self.sheen_textures(job);
+        if let (Some(t), Some(cube), Some(tables)) = (&sheen, &baked.sheen, &baked.sheen_tables) {
+            write(&t.cube, &cube.texels, cube.layout, FACES, 4);
+            let texels: Vec<Vec4> = tables.texels.iter().map(|v| v.extend(0.0).extend(0.0)).collect();
+            write(&t.tables, &texels, CubeLayout::new(tables.size, 1), 1, 2);
+        }
+        self.ibl(job, textures, sheen, baked.timings.clone())
     }
 
     /// Copies mip 0 of `texture` (every layer) into a buffer of 256-byte-aligned rows:
@@ -487,8 +551,14 @@ impl Ibl {
             irradiance: Some(cube(&self.irradiance).await?),
             sh9: None,
             lut: Some(brdf),
-            sheen: None,
-            sheen_tables: None,
+            sheen: match &self.sheen {
+                Some(t) => Some(cube(&t.cube).await?),
+                None => None,
+            },
+            sheen_tables: match &self.sheen {
+                Some(t) => Some(Lut { size: t.tables.size().width, texels: read_halves(device, queue, &t.tables, 2).await?.into_iter().map(|v| v.truncate().truncate()).collect() }),
+                None => None,
+            },
             timings: self.timings.clone(),
         })
     }

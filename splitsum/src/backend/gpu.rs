@@ -752,11 +752,11 @@ impl Kernels for Gpu {
     fn prefilter(&self, src: &Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Texels> {
         let out = job.layout;
         let buffers = [bytes(src.count as u64), 3 * bytes(out.texel_count() as u64)];
-        if !self.fits(&format!("prefiltering from the {}² source cube", src_layout.size), &buffers) {
-            return self.upload("specular", &Cpu.prefilter(&self.read_texels(src)?, src_layout, job)?);
+        if !self.fits(&format!("the {} cube from the {}² source cube", job.what(), src_layout.size), &buffers) {
+            return self.upload(job.what(), &Cpu.prefilter(&self.read_texels(src)?, src_layout, job)?);
         }
-        let accum = self.output("specular sums", 3 * bytes(out.texel_count() as u64))?;
-        let result = self.texels("specular", out.texel_count())?;
+        let accum = self.output("prefilter sums", 3 * bytes(out.texel_count() as u64))?;
+        let result = self.texels(job.what(), out.texel_count())?;
         for &m in job.levels {
             let (r, samples, exact_level) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
             let s = out.level_size(m);

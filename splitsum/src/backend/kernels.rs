@@ -39,6 +39,16 @@ pub struct Prefilter<'a> {
     pub lod_bias: f32,
 }
 
+impl Prefilter<'_> {
+    /// What the cube is, for progress and labels: `specular` or `sheen`.
+    pub fn what(&self) -> &'static str {
+        match self.lobe {
+            Lobe::Ggx => "specular",
+            Lobe::Charlie => "sheen",
+        }
+    }
+}
+
 /// The operations a bake is made of, on one backend. Cubes are texels in `CubeLayout`
 /// order; tables are rows of `(A, B, 0, 0)`.
 pub trait Kernels {
