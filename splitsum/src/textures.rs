@@ -193,33 +193,29 @@ impl Baker {
         }
     }
 
-    /// The textures of `job`'s products, empty.
-    fn textures(&self, job: &Job) -> (wgpu::Texture, wgpu::Texture, wgpu::Texture) {
-        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
-        let cube = |label, size, mips| {
-            self.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: FACES },
-                mip_level_count: mips,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: wgpu::TextureFormat::Rgba16Float,
-                usage,
-                view_formats: &[],
-            })
-        };
-        let lut = job.lut_size;
-        let brdf = self.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("splitsum brdf table"),
-            size: wgpu::Extent3d { width: lut, height: lut, depth_or_array_layers: 1 },
-            mip_level_count: 1,
+    /// An empty square texture for the products: `layers` layers (6 for a cube) of
+    /// `size`², `mips` levels, sampled, written and read back by copies.
+    fn texture(&self, label: &str, size: u32, layers: u32, mips: u32, format: wgpu::TextureFormat) -> wgpu::Texture {
+        self.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+            mip_level_count: mips,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rg16Float,
-            usage,
+            format,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
-        });
-        (cube("splitsum specular", job.size, job.mips), cube("splitsum irradiance", job.irradiance_size, 1), brdf)
+        })
+    }
+
+    /// The textures of `job`'s products, empty.
+    fn textures(&self, job: &Job) -> (wgpu::Texture, wgpu::Texture, wgpu::Texture) {
+        let half4 = wgpu::TextureFormat::Rgba16Float;
+        (
+            self.texture("splitsum specular", job.size, FACES, job.mips, half4),
+            self.texture("splitsum irradiance", job.irradiance_size, FACES, 1, half4),
+            self.texture("splitsum brdf table", job.lut_size, 1, 1, wgpu::TextureFormat::Rg16Float),
+        )
     }
 
     /// The sheen cube and tables of `job`, empty, where it bakes them.
@@ -227,23 +223,10 @@ impl Baker {
         if !job.products.sheen {
             return None;
         }
-        let usage = wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | wgpu::TextureUsages::COPY_SRC;
-        let texture = |label, size, layers, mips, format| {
-            self.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
-                mip_level_count: mips,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
         let t = crate::table::SHEEN_TABLE_SIZE;
         Some(SheenTextures {
-            cube: texture("splitsum sheen", job.size, FACES, job.mips, wgpu::TextureFormat::Rgba16Float),
-            tables: texture("splitsum sheen tables", t, 1, 1, wgpu::TextureFormat::Rg16Float),
+            cube: self.texture("splitsum sheen", job.size, FACES, job.mips, wgpu::TextureFormat::Rgba16Float),
+            tables: self.texture("splitsum sheen tables", t, 1, 1, wgpu::TextureFormat::Rg16Float),
             roughness: job.sheen_roughness_per_mip.clone(),
         })
     }
