@@ -146,6 +146,7 @@ case "$cmd" in
         ensure_browser
         ensure_test_display
         ensure_peers
+        ensure_viewer
         cargo +stable test --release --workspace "$@"
         # The GPU tests again on GL (llvmpipe, headless through EGL): every kernel, the
         # textures on the caller's device, the engine targets and the renderer, held to
@@ -190,7 +191,7 @@ case "$cmd" in
         ensure_browser
         ensure_peers
         ensure_viewer
-        XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp} exec cargo +stable test --release -p splitsum-tests --test suite sample_viewer -- --ignored --nocapture "$@"
+        exec cargo +stable test --release -p splitsum-tests --test suite sample_viewer -- --nocapture "$@"
         ;;
     table)
         # The tables the library embeds (splitsum/src/table.rs), computed afresh.

@@ -230,11 +230,12 @@ fn sheen_shading_under_a_constant_sky_is_the_sheen_albedo() {
 }
 
 /// The display's sheen (`KHR_materials_sheen` shading, `shade::sheen_ibl` and
-/// `shade::sheen_direct`): a sphere grid with sheen (sheen roughness 0 to 1 across the
+/// `shade::sheen_direct`): a sphere grid with a sheen row (sheen roughness 0 to 1 across the
 /// columns) on the GPU against the CPU reference renderer, within the render tests' bound
 /// (`render::frame_bound`'s: float rounding, plus a half-float step where the GL backend
-/// renders to RGBA16F); and the sheen visibly there (the frame differs from the same grid
-/// without sheen by more than 0.05 in display value somewhere).
+/// renders to RGBA16F); the row below the metalness rows, the only one with sheen; and the
+/// sheen visibly there (the frame differs from the same layout with a sheen colour of
+/// 10⁻³⁰ by more than 0.05 in display value somewhere).
 #[test]
 fn a_sheen_grid_renders_the_same_on_gpu_and_cpu() {
     use splitsum_display::render::{GpuScene, ViewState, render_cpu};
@@ -250,7 +251,21 @@ fn a_sheen_grid_renders_the_same_on_gpu_and_cpu() {
         assert!(a.is_finite() && b.is_finite());
         (*a - *b).abs().max_element()
     }).fold(0.0f32, f32::max);
-    let plain = render_cpu(&env, &ViewState { sheen_color: Vec3::ZERO, ..view.clone() }.frame(scene.shape, 96, 64, true));
+    // The layout: the grid's rows, then the sheen row, the only one with sheen, its
+    // metalness the top row's, its sheen roughness across the columns.
+    let f = view.frame(scene.shape, 96, 64, true);
+    assert_eq!(f.rows, view.grid.0 + 1);
+    for row in 0..f.rows {
+        for col in 0..f.columns {
+            let m = splitsum_shaders::scene::grid_material(&f, row, col);
+            let last = row + 1 == f.rows;
+            assert_eq!(m.sheen_color, if last { view.sheen_color } else { Vec3::ZERO }, "row {row}");
+            let metallic = if last { 0.0 } else { row as f32 / (view.grid.0 - 1) as f32 };
+            assert!((m.metallic - metallic).abs() < 1e-6, "row {row}: metallic {}", m.metallic);
+            assert!((m.sheen_roughness - col as f32 / (f.columns - 1) as f32).abs() < 1e-6);
+        }
+    }
+    let plain = render_cpu(&env, &ViewState { sheen_color: Vec3::splat(1e-30), ..view.clone() }.frame(scene.shape, 96, 64, true));
     let effect = c.iter().zip(&plain).map(|(a, b)| (*a - *b).abs().max_element()).fold(0.0f32, f32::max);
     let half = GpuScene::offscreen_format(gpu) == wgpu::TextureFormat::Rgba16Float;
     let bound = support::gpu_bound(1e-5, 2e-4) as f32 + if half { 2f32.powi(-11) } else { 0.0 };

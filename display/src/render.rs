@@ -40,7 +40,8 @@ pub struct ViewState {
     pub sky_blur: f32,
     /// Models and lights.
     pub options: ShadeOptions,
-    /// Sphere grid rows (metalness) and columns (roughness).
+    /// Sphere grid rows (metalness) and columns (roughness); with a sheen colour, a sheen
+    /// row below them.
     pub grid: (u32, u32),
     /// Draw the sphere grid.
     pub spheres: bool,
@@ -50,7 +51,7 @@ pub struct ViewState {
     pub base_color: Vec3,
     /// The grid's metalness range (top to bottom row) and roughness range (left to right).
     pub grid_ranges: Vec4,
-    /// Sheen colour of the spheres (black: none).
+    /// Sheen colour of the grid's sheen row (black: no sheen row).
     pub sheen_color: Vec3,
     /// The grid's sheen roughness range (left to right column).
     pub sheen_ranges: (f32, f32),
@@ -170,7 +171,7 @@ impl ViewState {
             height: height as f32,
             exposure: self.exposure,
             sky_blur: self.sky_blur,
-            rows: self.grid.0,
+            rows: self.grid.0 + (self.sheen_color.max_element() > 0.0) as u32,
             columns: self.grid.1,
             tonemapper: self.tonemapper as u32,
             light_count: self.lights.len().min(MAX_LIGHTS) as u32,

@@ -99,10 +99,12 @@ pub struct MaterialSpec {
     #[serde(default = "half")]
     pub roughness: Param,
     /// Sheen colour (linear RGB; `KHR_materials_sheen`'s `sheenColorFactor`): black, the
-    /// default, is no sheen.
+    /// default, is no sheen. A sphere grid of a material with sheen gets a sheen row below
+    /// its metalness rows.
     #[serde(default)]
     pub sheen_color: [f32; 3],
-    /// Sheen roughness (`sheenRoughnessFactor`, perceptual; the lobe's `α` is its square).
+    /// Sheen roughness (`sheenRoughnessFactor`, perceptual; the lobe's `α` is its square),
+    /// along the sheen row's columns where it is a range.
     #[serde(default = "zero")]
     pub sheen_roughness: Param,
     /// Diffuse model.

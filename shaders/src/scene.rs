@@ -49,7 +49,8 @@ pub struct Frame {
     pub exposure: f32,
     /// Blur of the sky: a specular mip, fractional.
     pub sky_blur: f32,
-    /// Rows of the sphere grid (metalness).
+    /// Rows of the sphere grid: metalness, then one sheen row where `sheen_color` is not
+    /// black ([`grid_material`]).
     pub rows: u32,
     /// Columns of the sphere grid (roughness).
     pub columns: u32,
@@ -79,7 +80,7 @@ pub struct Frame {
     /// The grid's metalness from the top row to the bottom (`x`, `y`) and roughness from
     /// the left column to the right (`z`, `w`).
     pub grid_ranges: Vec4,
-    /// Sheen colour of the spheres (`xyz`, linear; black: no sheen).
+    /// Sheen colour of the grid's sheen row (`xyz`, linear; black: no sheen row).
     pub sheen_color: Vec4,
     /// The grid's sheen roughness from the left column to the right (`x`, `y`; `z`, `w`
     /// unused).
@@ -154,20 +155,27 @@ pub fn hit_grid(frame: &Frame, origin: Vec3, dir: Vec3) -> (f32, u32, u32) {
 }
 
 /// The material of the sphere in `row`, `col`: metalness rises down the rows, roughness
-/// along the columns, over the frame's `grid_ranges`.
+/// along the columns, over the frame's `grid_ranges`. Where the frame has a sheen colour,
+/// the last row is the sheen row: the top row's metalness, the same roughness per column,
+/// and the sheen layer, its roughness rising along the columns over `sheen_ranges`; the
+/// rows above it carry no sheen.
 #[inline]
 pub fn grid_material(frame: &Frame, row: u32, col: u32) -> Material {
     let r = frame.grid_ranges;
+    let s = frame.sheen_ranges;
+    let has_sheen_row = frame.sheen_color.x > 0.0 || frame.sheen_color.y > 0.0 || frame.sheen_color.z > 0.0;
+    let sheen_row = has_sheen_row && row + 1 == frame.rows;
+    let metal_rows = if has_sheen_row && frame.rows > 1 { frame.rows - 1 } else { frame.rows };
     Material {
         base_color: frame.base_color.truncate(),
         // Clamped so that rounding never steps outside the declared range (a plan bakes
         // only the mips that range reads).
-        metallic: math::clamp(r.x + (r.y - r.x) * step(row, frame.rows), r.x, r.y),
+        metallic: if sheen_row { r.x } else { math::clamp(r.x + (r.y - r.x) * step(row, metal_rows), r.x, r.y) },
         roughness: math::clamp(r.z + (r.w - r.z) * step(col, frame.columns), r.z, r.w),
         occlusion: 1.0,
         emissive: Vec3::ZERO,
-        sheen_color: frame.sheen_color.truncate(),
-        sheen_roughness: math::clamp(frame.sheen_ranges.x + (frame.sheen_ranges.y - frame.sheen_ranges.x) * step(col, frame.columns), frame.sheen_ranges.x, frame.sheen_ranges.y),
+        sheen_color: if sheen_row { frame.sheen_color.truncate() } else { Vec3::ZERO },
+        sheen_roughness: math::clamp(s.x + (s.y - s.x) * step(col, frame.columns), s.x, s.y),
     }
 }
 

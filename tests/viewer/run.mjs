@@ -1,7 +1,8 @@
 // Serves the viewer page (this folder), the renderer (node_modules) and DATA on loopback,
-// opens the page in headless Chromium (WebGL2 on SwiftShader) and renders each job of
-// JOBS (a JSON list of { folder?, model, sheen_e, w, h, exposure }), writing the frames to
-// OUTPUT as JSON ({ mips, px } per job), or the browser's error to stderr.
+// opens the page in headless Chromium (WebGL2 on SwiftShader) and renders the models of
+// JOBS ({ folders, models, sheen_e, w, h, exposure, mips }) under each lighting, writing
+// the frames to OUTPUT as JSON ({ folder, model, mips, px } per frame, model-major), or the
+// browser's error to stderr.
 import { createServer } from "node:http";
 import { readFile, writeFile } from "node:fs/promises";
 import { extname, join } from "node:path";
@@ -33,17 +34,13 @@ const browser = await puppeteer.launch({
          "--disable-background-networking", "--disable-component-update", "--no-first-run"],
 });
 try {
-  const out = [];
-  for (const job of JSON.parse(await readFile(jobsPath, "utf8"))) {
-    const page = await browser.newPage();
-    // The renderer looks for a Draco decoder it is not given (no model here is compressed):
-    // its error is logged, not fatal; a failed render rejects the evaluation below.
-    page.on("pageerror", (e) => console.error("page error:", String(e)));
-    await page.goto(`http://127.0.0.1:${server.address().port}/index.html`);
-    await page.waitForFunction("window.ready === true");
-    out.push(await page.evaluate(async (o) => await window.render(o), job));
-    await page.close();
-  }
+  const page = await browser.newPage();
+  // The renderer looks for a Draco decoder it is not given (no model here is compressed):
+  // its error is logged, not fatal; a failed render rejects the evaluation below.
+  page.on("pageerror", (e) => console.error("page error:", String(e)));
+  await page.goto(`http://127.0.0.1:${server.address().port}/index.html`);
+  await page.waitForFunction("window.ready === true");
+  const out = await page.evaluate(async (o) => await window.render(o), JSON.parse(await readFile(jobsPath, "utf8")));
   await writeFile(output, JSON.stringify(out));
 } finally {
   await browser.close();
