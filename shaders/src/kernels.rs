@@ -123,9 +123,8 @@ pub fn equirect_to_cube(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
 ) {
     let s = p.face_size;
-    if id.x < s && id.y < s && id.z < cubemap::FACES {
-        let v = equirect::cube_texel(pyramid, p.width, p.height, p.levels, equirect::Facing::from_u32(p.facing), id.z, id.x, id.y, s, p.supersample);
-        out[((id.z * s + id.y) * s + id.x) as usize] = v;
+    if let Some(i) = face_texel(id, s, 0) {
+        out[i] = equirect::cube_texel(pyramid, p.width, p.height, p.levels, equirect::Facing::from_u32(p.facing), id.z, id.x, id.y, s, p.supersample);
     }
 }
 
@@ -235,17 +234,21 @@ pub fn prefilter_exact(
     }
 }
 
+/// The index of the cube texel an invocation `id` of a `size`² × 6 dispatch works on
+/// (face `id.z`, column `id.x`, row `id.y`), `offset` texels into its buffer; nothing for
+/// the invocations past the faces' edges.
+#[inline]
+fn face_texel(id: UVec3, size: u32, offset: u32) -> Option<usize> {
+    if id.x < size && id.y < size && id.z < cubemap::FACES { Some((offset + (id.z * size + id.y) * size + id.x) as usize) } else { None }
+}
+
 /// The texel a prefilter kernel's invocation `id` works on: the source cube's layout, the
 /// texel's index in the output's sums and its direction; nothing outside the level.
 #[inline]
 fn prefilter_invocation(id: UVec3, p: &PrefilterParams) -> Option<(CubeLayout, usize, Vec3)> {
     let s = p.dst_size;
-    if id.x < s && id.y < s && id.z < cubemap::FACES {
-        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
-        Some((CubeLayout::new(p.src_size, p.src_levels), i, cubemap::texel_dir(id.z, id.x, id.y, s)))
-    } else {
-        None
-    }
+    let i = face_texel(id, s, p.dst_offset)?;
+    Some((CubeLayout::new(p.src_size, p.src_levels), i, cubemap::texel_dir(id.z, id.x, id.y, s)))
 }
 
 /// Parameters of [`irradiance_cube`] and [`irradiance_sh9_project`].
@@ -279,9 +282,8 @@ pub fn irradiance_cube(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
 ) {
     let s = p.dst_size;
-    if id.x < s && id.y < s && id.z < cubemap::FACES {
+    if let Some(i) = face_texel(id, s, 0) {
         let layout = CubeLayout::new(p.src_size, p.src_levels);
-        let i = ((id.z * s + id.y) * s + id.x) as usize;
         let n = cubemap::texel_dir(id.z, id.x, id.y, s);
         let partial = load_partial(accum, i);
         store_partial(accum, i, irradiance::accumulate(src, layout, p.src_level, p.geometry, n, p.start, p.count, partial));
@@ -436,10 +438,8 @@ pub fn prefilter_mirror(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
 ) {
     let s = p.dst_size;
-    if id.x < s && id.y < s && id.z < cubemap::FACES {
-        let layout = CubeLayout::new(p.src_size, p.src_levels);
-        let i = (p.dst_offset + (id.z * s + id.y) * s + id.x) as usize;
-        out[i] = prefilter::mirror_texel(src, layout, id.z, id.x, id.y, s);
+    if let Some(i) = face_texel(id, s, p.dst_offset) {
+        out[i] = prefilter::mirror_texel(src, CubeLayout::new(p.src_size, p.src_levels), id.z, id.x, id.y, s);
     }
 }
 
@@ -526,10 +526,10 @@ pub fn read_cube(
     #[spirv(descriptor_set = 0, binding = 3)] sampler: &spirv_std::Sampler,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] texels: &mut [Vec4],
 ) {
-    if id.x < p.size && id.y < p.size && id.z < cubemap::FACES {
+    if let Some(i) = face_texel(id, p.size, p.texel_offset) {
         let d = cubemap::texel_dir(id.z, id.x, id.y, p.size);
         let v: Vec4 = cube.sample_by_lod(*sampler, d, p.level as f32);
-        texels[(p.texel_offset + (id.z * p.size + id.y) * p.size + id.x) as usize] = half::clean_radiance(v);
+        texels[i] = half::clean_radiance(v);
     }
 }
 
@@ -558,9 +558,8 @@ pub fn calibrate(
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
 ) {
     let s = p.size;
-    if id.x < s && id.y < s && id.z < cubemap::FACES {
+    if let Some(i) = face_texel(id, s, 0) {
         let layout = CubeLayout::new(p.src_size, p.src_levels);
-        let i = ((id.z * s + id.y) * s + id.x) as usize;
         out[i] = calibrate::texel(src, layout, calibrate::Rate::from_u32(p.rate), id.z, id.x, id.y, s, p.count);
     }
 }
