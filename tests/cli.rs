@@ -81,7 +81,8 @@ fn a_failed_run_leaves_the_existing_output_alone() {
 fn lut_writes_exr_and_png() {
     let d = scratch("ok");
     let out = d.join("t.exr");
-    cli::run(["runner", "lut", "--size", "16", "--method", "sampled", "--samples", "64", "--backend", "cpu", "--png", "--out", out.to_str().unwrap()])
+    let preview = d.join("t.png");
+    cli::run(["runner", "lut", "--size", "16", "--method", "sampled", "--samples", "64", "--backend", "cpu", "--png", preview.to_str().unwrap(), "--out", out.to_str().unwrap()])
         .expect("bake");
     let png = image::open(d.join("t.png")).expect("png").to_rgb8();
     assert_eq!(png.dimensions(), (16, 16));

@@ -408,6 +408,42 @@ fn the_cache_reuses_unchanged_bakes_and_rebuilds_bad_entries() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The cache trusts nothing it finds (issue 31): an entry that is a link to a folder of
+/// the user's holding files named as the cache names its own is refused and nothing
+/// behind it removed; a lock file planted as a link to a file elsewhere is not followed
+/// (the file is neither created nor opened).
+#[test]
+fn the_cache_follows_no_link_it_finds() {
+    let dir = temp("cache-links");
+    let cache = Cache::new(&dir);
+    let cal = Calibration::default();
+    let s = scene("", &format!("{}\n{QUICK}", material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
+    let key = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).unwrap().key;
+    // The user's folder, with files named as an entry's.
+    let mine = temp("cache-links-mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    for name in ["manifest.json", "specular.bin"] {
+        std::fs::write(mine.join(name), b"mine").unwrap();
+    }
+    std::fs::remove_dir_all(dir.join(&key)).unwrap();
+    std::os::unix::fs::symlink(&mine, dir.join(&key)).unwrap();
+    let e = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).err().expect("a linked entry").to_string();
+    assert!(e.contains("symbolic link"), "{e}");
+    for name in ["manifest.json", "specular.bin"] {
+        assert_eq!(std::fs::read(mine.join(name)).unwrap(), b"mine", "{name} behind the link");
+    }
+    std::fs::remove_file(dir.join(&key)).unwrap();
+    // A planted lock link to a file that does not exist yet.
+    let elsewhere = mine.join("created-through-the-lock");
+    let _ = std::fs::remove_file(dir.join(format!("{key}.lock")));
+    std::os::unix::fs::symlink(&elsewhere, dir.join(format!("{key}.lock"))).unwrap();
+    let e = bake::bake_scene(&Backend::Cpu, &s, &cal, Some(&cache), false).err().expect("a linked lock").to_string();
+    assert!(e.contains("cache lock"), "{e}");
+    assert!(!elsewhere.exists(), "the lock link was followed");
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&mine);
+}
+
 fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for e in std::fs::read_dir(from).unwrap() {

@@ -2,21 +2,11 @@
 //! memory (measured by the kernel, `getrusage`), interruptions, a full disk and concurrent
 //! runs. Large inputs are generated here, never committed.
 
+mod common;
+
+use common::{courtyard, runner, scratch, snapshot};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn runner() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_runner"));
-    c.env("XDG_RUNTIME_DIR", std::env::temp_dir());
-    c
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("splitsum-process-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
 
 fn text(o: &Output) -> String {
     format!("status {:?}\nstdout:\n{}\nstderr:\n{}", o.status, String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
@@ -128,10 +118,6 @@ fn the_gpu_backend_takes_inputs_beyond_its_binding_limit() {
         let worst = a.iter().zip(&b).map(|(x, y)| (x - y).abs() / y.abs().max(1e-3)).fold(0.0f32, f32::max);
         assert!(worst < 1e-3, "mip {m}: worst relative difference {worst}");
     }
-}
-
-fn courtyard() -> String {
-    format!("{}/../splitsum/assets/courtyard.exr", env!("CARGO_MANIFEST_DIR"))
 }
 
 fn listing(dir: &Path) -> Vec<String> {
@@ -623,25 +609,6 @@ fn run_code(args: &[&str]) -> (i32, String) {
     (o.status.code().unwrap_or(-1), format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr)))
 }
 
-/// Every file below `dir` with its bytes, in sorted order.
-fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
-    let mut out = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        for e in std::fs::read_dir(&d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                out.push((p.clone(), Vec::new()));
-                stack.push(p);
-            } else {
-                out.push((p.clone(), std::fs::read(&p).unwrap()));
-            }
-        }
-    }
-    out.sort();
-    out
-}
-
 /// The cases a new user met (issue 19), each with the message that names the real problem
 /// and the one exit-code rule: 2 for a request refused as written, 1 for work that failed.
 /// A folder of the user's files is never replaced, by any command; a bake whose settings
@@ -686,15 +653,43 @@ fn each_case_names_the_real_problem_with_one_exit_code_rule() {
     let (code, said) = run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", &out]);
     assert!(code == 2 && said.contains("holds bake.json, which has changed since splitsum wrote it"), "{said}");
     assert_eq!(std::fs::read_to_string(d.join("out/bake.json")).unwrap(), "{\"edited\": true}");
+    // Folders that are no output folder: the root, a system folder (refused at its first
+    // entry, unread below), one that cannot be listed (issue 31).
+    let (code, said) = run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", "/"]);
+    assert!(code == 2 && said.contains("--out / is the root of the file system"), "{said}");
+    let start = std::time::Instant::now();
+    let (code, said) = run_code(&["bake", &env, "--backend", "cpu", "--size", "16", "--out", "/usr"]);
+    assert!(code == 2 && said.contains("--out /usr holds ") && said.contains("(the folder has no .splitsum-manifest.json)"), "{said}");
+    println!("--out /usr refused in {:.3} s (the whole process)", start.elapsed().as_secs_f64());
+    let locked = d.join("locked");
+    std::fs::create_dir_all(locked.join("inside")).unwrap();
+    std::fs::set_permissions(&locked, std::os::unix::fs::PermissionsExt::from_mode(0o000)).unwrap();
+    // Root reads any folder: run as nobody there (setpriv, util-linux), where it exists.
+    // SAFETY: getuid has no preconditions.
+    let root = unsafe { libc::getuid() } == 0;
+    let args = ["bake", &env, "--backend", "cpu", "--size", "16", "--out", locked.to_str().unwrap()];
+    let as_user = if root { Command::new("setpriv").args(["--reuid=65534", "--regid=65534", "--clear-groups", env!("CARGO_BIN_EXE_runner")]).args(args).output().ok() } else { runner().args(args).output().ok() };
+    // Skipped where nobody may run the binary (a checkout under a private home folder).
+    if let Some(o) = as_user.filter(|o| !matches!(o.status.code(), Some(126 | 127)) && !String::from_utf8_lossy(&o.stderr).contains("failed to execute")) {
+        let said = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+        assert!(o.status.code() == Some(2) && said.contains("cannot be read (permission denied)"), "{said}");
+    }
+    std::fs::set_permissions(&locked, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
+    assert!(locked.join("inside").is_dir());
     // Single files: never another kind, never under the wrong extension.
-    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--png", "--out", &dir("t.png")]);
+    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--out", &dir("t.png")]);
     assert!(code == 2 && said.contains("--out") && said.contains("name it .exr"), "{said}");
     std::fs::write(d.join("mine.exr"), "not an EXR").unwrap();
     let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--out", &dir("mine.exr")]);
     assert!(code == 2 && said.contains("exists and is not a OpenEXR file"), "{said}");
     assert_eq!(std::fs::read(d.join("mine.exr")).unwrap(), b"not an EXR");
-    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--png", "--out", &dir("t.exr")]);
-    assert!(code == 0 && said.matches("wrote").count() == 2 && said.contains("t.exr") && said.contains("t.png"), "{said}");
+    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--png", &dir("preview.png"), "--out", &dir("t.exr")]);
+    assert!(code == 0 && said.matches("wrote").count() == 2 && said.contains("t.exr") && said.contains("preview.png"), "{said}");
+    // A PNG beside the table that the user never named is never touched (issue 31).
+    std::fs::write(d.join("u.png"), b"\x89PNG mine").unwrap();
+    let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--out", &dir("u.exr")]);
+    assert!(code == 0 && !said.contains("u.png"), "{said}");
+    assert_eq!(std::fs::read(d.join("u.png")).unwrap(), b"\x89PNG mine");
     // Nothing silent: a flag the path ignores is refused, a cap or an upsampling is stated.
     let (code, said) = run_code(&["lut", "--backend", "cpu", "--size", "8", "--samples", "64", "--out", &dir("u.exr")]);
     assert!(code == 2 && said.contains("--samples") && said.contains("--method sampled"), "{said}");
@@ -757,207 +752,3 @@ fn each_case_names_the_real_problem_with_one_exit_code_rule() {
     assert!(!d.join("x").exists(), "a refused run left its output");
 }
 
-/// One step of the promise's property test.
-#[derive(Clone, Debug)]
-enum Op {
-    /// `bake` into folder `folder` for target `target` (splitsum, khronos, filament).
-    Bake { folder: usize, target: usize, size: u32 },
-    /// `bake --scene` into `folder`.
-    Scene { folder: usize },
-    /// `report --quick` into `folder`.
-    Report { folder: usize },
-    /// The user writes a file into `folder` (which may be an output folder by then).
-    UserWrites { folder: usize, name: String, bytes: Vec<u8> },
-    /// `op`, interrupted by `signal` after `after_ms`.
-    Interrupted { op: Box<Op>, after_ms: u64, signal: i32 },
-}
-
-/// The arguments of a command op.
-fn op_args(op: &Op, env: &Path, scene: &Path, folders: &[PathBuf]) -> Vec<String> {
-    let s = |v: &[&str]| v.iter().map(|a| a.to_string()).collect::<Vec<_>>();
-    match op {
-        Op::Bake { folder, target, size } => {
-            let target = ["splitsum", "khronos", "filament"][*target];
-            let mut a = s(&["bake", env.to_str().unwrap(), "--backend", "cpu", "--size", &size.to_string(), "--target", target]);
-            if target != "filament" {
-                a.extend(s(&["--lut-size", "8", "--irradiance-size", "4"]));
-            }
-            a.extend(s(&["--out", folders[*folder].to_str().unwrap()]));
-            a
-        }
-        Op::Scene { folder } => s(&["bake", "--scene", scene.to_str().unwrap(), "--backend", "cpu", "--out", folders[*folder].to_str().unwrap()]),
-        Op::Report { folder } => s(&["report", env.to_str().unwrap(), "--quick", "--backends", "cpu", "--out", folders[*folder].to_str().unwrap()]),
-        Op::UserWrites { .. } | Op::Interrupted { .. } => unreachable!("not a command"),
-    }
-}
-
-/// Whether `dir` is a whole set written by splitsum, read independently of the library:
-/// its manifest lists every entry there, every listed entry is there, and every file has
-/// the listed size and BLAKE3 hash.
-fn whole_new_set(dir: &Path) -> Result<(), String> {
-    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join(".splitsum-manifest.json")).map_err(|e| format!("no manifest: {e}"))?)
-        .map_err(|e| format!("manifest: {e}"))?;
-    let mut listed = std::collections::BTreeSet::new();
-    for e in manifest["entries"].as_array().ok_or("no entries")? {
-        let rel = e["path"].as_str().ok_or("entry without a path")?;
-        listed.insert(dir.join(rel));
-        let p = dir.join(rel);
-        match e.get("file") {
-            Some(f) => {
-                let bytes = std::fs::read(&p).map_err(|err| format!("{rel}: {err}"))?;
-                if bytes.len() as u64 != f["bytes"].as_u64().unwrap() || blake3::hash(&bytes).to_hex().as_str() != f["blake3"].as_str().unwrap() {
-                    return Err(format!("{rel} differs from the manifest"));
-                }
-            }
-            None if p.is_dir() => {}
-            None => return Err(format!("{rel} is not a folder")),
-        }
-    }
-    for (p, _) in snapshot(dir) {
-        if p != dir.join(".splitsum-manifest.json") && !listed.contains(&p) {
-            return Err(format!("{} is not listed", p.display()));
-        }
-    }
-    Ok(())
-}
-
-fn ops() -> impl proptest::strategy::Strategy<Value = Vec<Op>> {
-    use proptest::prelude::*;
-    let command = prop_oneof![
-        9 => (0usize..2, 0usize..3, prop_oneof![Just(8u32), Just(16)]).prop_map(|(folder, target, size)| Op::Bake { folder, target, size }),
-        5 => (0usize..2).prop_map(|folder| Op::Scene { folder }),
-        1 => (0usize..2).prop_map(|folder| Op::Report { folder }),
-    ];
-    let op = prop_oneof![
-        10 => command.clone(),
-        3 => (0usize..2, "[a-z]{1,8}(\\.txt|\\.json|\\.exr)?", prop::collection::vec(any::<u8>(), 0..64))
-            .prop_map(|(folder, name, bytes)| Op::UserWrites { folder, name, bytes }),
-        5 => (command, 0u64..150, prop_oneof![Just(libc::SIGINT), Just(libc::SIGTERM)])
-            .prop_map(|(op, after_ms, signal)| Op::Interrupted { op: Box::new(op), after_ms, signal }),
-    ];
-    prop::collection::vec(op, 1..5)
-}
-
-/// The promise (issue 19), as a property: random sequences of `bake` (three targets),
-/// `bake --scene`, `report` and interruptions (SIGINT, SIGTERM) run into two folders that
-/// start missing, empty or holding the user's files, while the user adds files into them
-/// (outputs included). After every step every file of the user's is there byte for byte,
-/// every output folder is either the whole old set or a whole new set (read independently
-/// of the library), a folder holding the user's files is refused with exit code 2, and no
-/// staging folder is left. `PROPTEST_CASES` sets the number of sequences (200 by default;
-/// more by hand).
-#[test]
-fn the_users_files_survive_any_sequence_of_runs() {
-    use proptest::prelude::*;
-    use proptest::test_runner::{Config, TestRunner};
-    let d = scratch("promise");
-    let env = d.join("tiny.hdr");
-    {
-        use std::io::Write;
-        let mut f = std::fs::File::create(&env).unwrap();
-        write!(f, "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32 +X 64\n").unwrap();
-        for i in 0..64 * 32u32 {
-            f.write_all(&[100 + (i % 64) as u8, 100, 100 + (i / 64) as u8, 128]).unwrap();
-        }
-    }
-    let scene = d.join("tiny.toml");
-    std::fs::write(
-        &scene,
-        "environment = \"tiny.hdr\"\n[quality]\nsize = 8\nlut_size = 8\n[[materials]]\nname = \"steel\"\nmetallic = 1.0\nroughness = [0.4, 0.7]\n[[objects]]\nkind = \"sphere-grid\"\nmaterial = \"steel\"\n",
-    )
-    .unwrap();
-    let cases = std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(200);
-    let mut runner_ = TestRunner::new(Config { cases, failure_persistence: None, ..Config::default() });
-    let case = std::sync::atomic::AtomicUsize::new(0);
-    let start = std::time::Instant::now();
-    let result = runner_.run(&(prop::collection::vec(0u8..3, 2), prop::collection::vec(("[a-z]{1,6}\\.(tex|png|json)", prop::collection::vec(any::<u8>(), 1..32)), 0..3), ops()), |(starts, seeds, ops)| {
-        let root = d.join(format!("case{}", case.fetch_add(1, std::sync::atomic::Ordering::Relaxed)));
-        let folders = [root.join("out"), root.join("deep/report")];
-        std::fs::create_dir_all(&root).unwrap();
-        // The user's files: beside the output folders always, inside them where a folder starts so.
-        let mut mine: std::collections::BTreeMap<PathBuf, Vec<u8>> = Default::default();
-        std::fs::write(root.join("thesis.tex"), b"mine").unwrap();
-        mine.insert(root.join("thesis.tex"), b"mine".to_vec());
-        for (k, start) in starts.iter().enumerate() {
-            match start {
-                0 => {}
-                1 => std::fs::create_dir_all(&folders[k]).unwrap(),
-                _ => {
-                    std::fs::create_dir_all(folders[k].join("figs")).unwrap();
-                    for (name, bytes) in seeds.iter().chain([&("plan.json".to_string(), b"{}".to_vec())]) {
-                        for p in [folders[k].join(name), folders[k].join("figs").join(name)] {
-                            std::fs::write(&p, bytes).unwrap();
-                            mine.insert(p, bytes.clone());
-                        }
-                    }
-                }
-            }
-        }
-        for op in &ops {
-            let before: Vec<_> = folders.iter().map(|f| snapshot_or_none(f)).collect();
-            let holds_mine: Vec<bool> = folders.iter().map(|f| mine.keys().any(|p| p.starts_with(f))).collect();
-            let (command, signal) = match op {
-                Op::UserWrites { folder, name, bytes } => {
-                    let p = folders[*folder].join(name);
-                    std::fs::create_dir_all(&folders[*folder]).unwrap();
-                    if !p.exists() {
-                        std::fs::write(&p, bytes).unwrap();
-                        mine.insert(p, bytes.clone());
-                    }
-                    continue;
-                }
-                Op::Interrupted { op, after_ms, signal } => (op.as_ref(), Some((*after_ms, *signal))),
-                op => (op, None),
-            };
-            let folder = match command {
-                Op::Bake { folder, .. } | Op::Scene { folder } | Op::Report { folder } => *folder,
-                _ => unreachable!(),
-            };
-            let args = op_args(command, &env, &scene, &folders);
-            let child = runner().args(&args).stdout(std::process::Stdio::null()).stderr(std::process::Stdio::piped()).spawn().unwrap();
-            if let Some((after, sig)) = signal {
-                std::thread::sleep(std::time::Duration::from_millis(after));
-                // SAFETY: signalling our own child (it may have exited already).
-                unsafe { libc::kill(child.id() as i32, sig) };
-            }
-            let o = child.wait_with_output().unwrap();
-            let said = String::from_utf8_lossy(&o.stderr).into_owned();
-            let code = o.status.code();
-            for (p, bytes) in &mine {
-                let now = std::fs::read(p).ok();
-                prop_assert_eq!(now.as_ref(), Some(bytes), "{:?} lost or changed by {:?}: {}", p, op, said);
-            }
-            for (k, f) in folders.iter().enumerate() {
-                let now = snapshot_or_none(f);
-                if now != before[k] {
-                    prop_assert!(k == folder && !holds_mine[k], "{:?} changed folder {} holding the user's files: {}", op, k, said);
-                    let whole = whole_new_set(f);
-                    prop_assert!(whole.is_ok(), "{:?} left folder {} neither old nor whole new: {:?}: {}", op, k, whole, said);
-                }
-            }
-            if holds_mine[folder] {
-                prop_assert!(code == Some(2) || (signal.is_some() && code.is_none()) || code == Some(130), "{:?} into a folder of the user's: {:?}: {}", op, code, said);
-            } else if signal.is_none() {
-                prop_assert_eq!(code, Some(0), "{:?}: {}", op, said);
-            }
-            for dir in [root.clone(), root.join("deep")] {
-                for e in std::fs::read_dir(&dir).into_iter().flatten() {
-                    let name = e.unwrap().file_name().to_string_lossy().into_owned();
-                    prop_assert!(!name.contains(".splitsum-") && !name.ends_with(".tmp"), "{:?} left {} in {}: {}", op, name, dir.display(), said);
-                }
-            }
-        }
-        let _ = std::fs::remove_dir_all(&root);
-        Ok(())
-    });
-    eprintln!("{cases} sequences in {:.1} s", start.elapsed().as_secs_f64());
-    if let Err(e) = result {
-        panic!("{e}");
-    }
-    let _ = std::fs::remove_dir_all(&d);
-}
-
-/// [`snapshot`] of `dir`, or `None` where it does not exist.
-fn snapshot_or_none(dir: &Path) -> Option<Vec<(PathBuf, Vec<u8>)>> {
-    dir.is_dir().then(|| snapshot(dir))
-}

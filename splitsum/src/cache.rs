@@ -68,25 +68,39 @@ const ENTRY_FILES: [&str; 7] = ["manifest.json", "source.bin", "specular.bin", "
 /// The largest entry manifest read (a real one is under a kilobyte).
 const MAX_MANIFEST_BYTES: u64 = 1 << 20;
 
-/// Removes the entry folder `dir`, only if it holds nothing but the files the cache writes
-/// (`ENTRY_FILES`); otherwise it is left as it is, and the error names what the cache did
-/// not write.
+/// Removes the entry folder `dir`, only if it is a folder (not a link to one) holding
+/// nothing but the files the cache writes (`ENTRY_FILES`, each a regular file); otherwise
+/// it is left as it is, and the error names what the cache did not write. The files are
+/// removed through a handle to the entry, never through a link.
 fn remove_entry(dir: &Path) -> Result<()> {
-    let entries: Vec<_> = std::fs::read_dir(dir)
-        .and_then(|r| r.collect::<std::io::Result<Vec<_>>>())
-        .map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))?;
-    for e in &entries {
-        let name = e.file_name().to_string_lossy().into_owned();
-        let is_file = e.file_type().is_ok_and(|t| t.is_file());
-        if !is_file || !ENTRY_FILES.contains(&name.as_str()) {
-            return Err(Error::file(
-                dir,
-                format!("this cache entry holds {name}, which splitsum did not write; the cache removes only its own files: move it away, or use another cache folder"),
-            ));
-        }
+    let foreign = |what: &str| {
+        Error::file(
+            dir,
+            format!("this cache entry {what}, which splitsum did not write; the cache removes only its own files: move it away, or use another cache folder"),
+        )
+    };
+    match std::fs::symlink_metadata(dir) {
+        Ok(m) if m.file_type().is_symlink() => return Err(foreign("is a symbolic link")),
+        Ok(m) if !m.is_dir() => return Err(foreign("is not a folder")),
+        Ok(_) => {}
+        Err(e) => return Err(Error::file(dir, format!("cannot read the cache entry: {e}"))),
     }
-    for e in &entries {
-        std::fs::remove_file(e.path()).map_err(|err| Error::file(&e.path(), format!("cannot remove the stale cache file: {err}")))?;
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let entry = cap_std::fs::Dir::open_ambient_dir(dir, cap_std::ambient_authority()).map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))?;
+        let mut names = Vec::new();
+        for e in entry.entries().map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))? {
+            let e = e.map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))?;
+            let name = e.file_name().to_string_lossy().into_owned();
+            let is_file = e.file_type().is_ok_and(|t| t.is_file());
+            if !is_file || !ENTRY_FILES.contains(&name.as_str()) {
+                return Err(foreign(&format!("holds {name}")));
+            }
+            names.push(name);
+        }
+        for name in names {
+            entry.remove_file(&name).map_err(|err| Error::file(&dir.join(&name), format!("cannot remove the stale cache file: {err}")))?;
+        }
     }
     std::fs::remove_dir(dir).map_err(|e| Error::file(dir, format!("cannot remove the stale cache entry: {e}")))
 }
@@ -146,10 +160,13 @@ impl Cache {
     pub fn lock(&self, key: &str) -> Result<std::fs::File> {
         std::fs::create_dir_all(&self.dir).map_err(|e| Error::file(&self.dir, format!("cannot create the cache folder: {e}")))?;
         let path = self.dir.join(format!("{key}.lock"));
-        let file = std::fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
-            .write(true)
+        let mut options = std::fs::OpenOptions::new();
+        options.create(true).truncate(false).write(true);
+        // Never through a link: a planted `KEY.lock` link must not create or open a file
+        // elsewhere.
+        #[cfg(unix)]
+        std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW);
+        let file = options
             .open(&path)
             .map_err(|e| Error::file(&path, format!("cannot open the cache lock: {e}")))?;
         match file.try_lock() {
@@ -221,9 +238,19 @@ impl Cache {
 
     /// Stores `env` under `key` (atomically: a temporary folder renamed into place).
     pub fn put(&self, key: &str, env: &BakedEnvironment) -> Result<()> {
-        let tmp = self.dir.join(format!(".{key}.{}.tmp", std::process::id()));
         let fail = |e: std::io::Error| Error::file(&self.dir, format!("cannot write the cache: {e}"));
-        std::fs::create_dir_all(&tmp).map_err(fail)?;
+        std::fs::create_dir_all(&self.dir).map_err(fail)?;
+        // A folder of a name nobody has (created new, never one found there): the files
+        // below are written into this run's own folder.
+        let tmp = (0..1000u32)
+            .map(|k| self.dir.join(format!(".{key}.{}.{k}.tmp", std::process::id())))
+            .find_map(|p| match std::fs::create_dir(&p) {
+                Ok(()) => Some(Ok(p)),
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => None,
+                Err(e) => Some(Err(e)),
+            })
+            .unwrap_or_else(|| Err(std::io::Error::other("no free temporary folder name")))
+            .map_err(fail)?;
         let mut files = BTreeMap::new();
         let source = env.source.levels(0, 0);
         for (name, bytes) in [
@@ -240,7 +267,7 @@ impl Cache {
         let manifest = Manifest { format: FORMAT.into(), key: key.into(), mapping: env.mapping as u32, files };
         std::fs::write(tmp.join("manifest.json"), serde_json::to_string_pretty(&manifest).expect("serialisable")).map_err(fail)?;
         let dest = self.entry(key);
-        if dest.exists()
+        if std::fs::symlink_metadata(&dest).is_ok()
             && let Err(e) = remove_entry(&dest) {
                 let _ = std::fs::remove_dir_all(&tmp);
                 return Err(e);

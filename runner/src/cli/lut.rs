@@ -18,15 +18,18 @@ pub(super) struct LutArgs {
     /// Hammersley points per texel (with --method sampled).
     #[arg(long, allow_negative_numbers = true, value_parser = clap::value_parser!(u32).range(1..), default_value_t = 1024)]
     samples: u32,
-    /// Where to bake.
-    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "gpu")]
+    /// Where to bake: auto (the GPU; the CPU where the best adapter is a software
+    /// rasteriser such as lavapipe, or there is none), gpu (the best adapter, even a
+    /// software one), cpu.
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "auto")]
     backend: BackendKind,
     /// Output OpenEXR file (R = scale, G = bias, 32-bit float).
     #[arg(long, default_value = "lut.exr")]
     out: PathBuf,
-    /// Also write an 8-bit PNG preview beside it (same name, .png).
-    #[arg(long)]
-    png: bool,
+    /// Also write an 8-bit PNG preview of the table (R = scale, G = bias, stored linearly)
+    /// to this file.
+    #[arg(long, value_name = "FILE")]
+    png: Option<PathBuf>,
     /// Run even if the table is estimated to take over an hour.
     #[arg(long)]
     force: bool,
@@ -37,9 +40,12 @@ pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
         return Err(Usage::new("--samples sets the sampled table's count; the quadrature table (--method quadrature, the default) takes none: drop --samples, or add --method sampled").into());
     }
     files::check_output_file(&args.out, files::FileKind::Exr, "--out")?;
-    let png = args.png.then(|| args.out.with_extension("png"));
+    let png = args.png.clone();
     if let Some(p) = &png {
-        files::check_output_file(p, files::FileKind::Png, "--png (the preview beside --out)")?;
+        files::check_output_file(p, files::FileKind::Png, "--png")?;
+        if same_file(p, &args.out) {
+            return Err(Usage::new(format!("--png {} and --out {} name the same file: give the preview a name of its own", p.display(), args.out.display())).into());
+        }
     }
     // The table's flags, named as this command names them.
     let lut_flag = |f: Field| match f {
@@ -73,4 +79,10 @@ pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// Whether `a` and `b` name the same file (the same path as written, or the same existing
+/// file by another path).
+fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
+    a == b || matches!((std::fs::canonicalize(a), std::fs::canonicalize(b)), (Ok(x), Ok(y)) if x == y)
 }
