@@ -20,8 +20,10 @@ pub(super) struct BakeArgs {
     out: PathBuf,
     #[command(flatten)]
     quality: QualityArgs,
-    /// Where to bake.
-    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "gpu")]
+    /// Where to bake: auto (the GPU; the CPU where the best adapter is a software
+    /// rasteriser such as lavapipe, or there is none), gpu (the best adapter, even a
+    /// software one), cpu.
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "auto")]
     backend: BackendKind,
     /// A time budget per bake, in seconds, on this device: the specular sample count and
     /// the irradiance source are chosen for the lowest predicted error whose estimate fits

@@ -7,7 +7,9 @@ use crate::bake;
 /// window, or, where there is no display (or no GPU), render it to `splitsum.png`.
 pub(super) fn default_run() -> anyhow::Result<()> {
     let (env, name) = load_environment(None, false)?;
-    let backend = match Backend::open(BackendKind::Gpu) {
+    // The bake's backend by the one rule (`BackendKind::Auto`: the CPU where the best
+    // adapter is a software rasteriser); the window, if any, draws on a device either way.
+    let backend = match Backend::open(BackendKind::Auto) {
         Ok(b) => b,
         Err(e) => {
             eprintln!("{e}\nfalling back to the CPU backend");
@@ -34,19 +36,20 @@ pub(super) fn default_run() -> anyhow::Result<()> {
         shading: Default::default(),
     };
     let state = look.view(baked.auto_exposure());
-    let backend = match backend {
-        Backend::Gpu(gpu) if crate::view::display_available() => {
-            let options = crate::view::ViewOptions { size: (960, 540), ..Default::default() };
-            let gpu = *gpu;
-            match crate::view::run(gpu, &baked, None, state.clone(), options) {
-                Ok(()) => return Ok(()),
-                Err(e) => {
-                    eprintln!("{e}; rendering to a file instead");
-                    Backend::open(BackendKind::Gpu).unwrap_or(Backend::Cpu)
-                }
-            }
+    let backend = if crate::view::display_available() {
+        let gpu = match backend {
+            Backend::Gpu(gpu) => Ok(*gpu),
+            Backend::Cpu => splitsum::Gpu::new(),
+        };
+        let options = crate::view::ViewOptions { size: (960, 540), ..Default::default() };
+        match gpu.map(|gpu| crate::view::run(gpu, &baked, None, state.clone(), options)) {
+            Ok(Ok(())) => return Ok(()),
+            Ok(Err(e)) => eprintln!("{e}; rendering to a file instead"),
+            Err(e) => eprintln!("{e}; rendering to a file instead"),
         }
-        b => b,
+        Backend::open(BackendKind::Auto).unwrap_or(Backend::Cpu)
+    } else {
+        backend
     };
     let (w, h) = (960, 540);
     let out = PathBuf::from("splitsum.png");

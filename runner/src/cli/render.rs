@@ -17,8 +17,9 @@ pub(super) struct RenderArgs {
     /// Height in pixels.
     #[arg(long, default_value_t = 540)]
     height: u32,
-    /// Bake and render on the GPU, or bake and render on the CPU (the reference renderer).
-    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "gpu")]
+    /// Bake and render on the GPU, or on the CPU (the reference renderer); auto: the GPU,
+    /// or the CPU where the best adapter is a software rasteriser such as lavapipe.
+    #[arg(long, value_parser = choice::<BackendKind>(), default_value = "auto")]
     backend: BackendKind,
     #[command(flatten)]
     look: LookArgs,

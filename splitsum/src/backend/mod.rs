@@ -22,13 +22,17 @@ pub use kernels::{Kernels, Prefilter, chunks};
 /// Which backend to bake with.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
 pub enum BackendKind {
-    /// wgpu on a Vulkan adapter (a real GPU, or Mesa's lavapipe on the CPU).
+    /// The GPU where the best adapter is one; the CPU where it is a software rasteriser on
+    /// the CPU (lavapipe, llvmpipe, SwiftShader, WARP), which runs the same kernels several
+    /// times slower than the CPU backend runs them natively, or where there is none.
+    Auto,
+    /// wgpu on the best adapter, whatever it is (a real GPU, or a software one).
     Gpu,
     /// The shader functions compiled natively, multi-threaded with rayon.
     Cpu,
 }
 
-splitsum_shaders::choice!(BackendKind: Gpu => "gpu", Cpu => "cpu");
+splitsum_shaders::choice!(BackendKind: Auto => "auto", Gpu => "gpu", Cpu => "cpu");
 
 /// An open backend.
 pub enum Backend {
@@ -56,11 +60,26 @@ macro_rules! with_kernels {
 pub(crate) use with_kernels;
 
 impl Backend {
-    /// Opens `kind` (for the GPU: adapter, device and pipelines, outside any timing).
+    /// Opens `kind` (for the GPU: adapter, device and pipelines, outside any timing). For
+    /// [`BackendKind::Auto`], a note says when the CPU is chosen, and why.
     pub fn open(kind: BackendKind) -> Result<Self> {
         Ok(match kind {
             BackendKind::Gpu => Backend::Gpu(Box::new(Gpu::new()?)),
             BackendKind::Cpu => Backend::Cpu,
+            BackendKind::Auto => match gpu::Gpu::unless_software()? {
+                Ok(gpu) => Backend::Gpu(Box::new(gpu)),
+                Err(passed) => {
+                    crate::progress::note(&match passed {
+                        Some(info) => format!(
+                            "note: the best GPU adapter here, {} on {}, is a software rasteriser on the CPU: baking on the CPU backend, which runs the same functions natively and faster (--backend gpu uses the adapter anyway)",
+                            info.name,
+                            gpu::api_name(info.backend)
+                        ),
+                        None => "note: no GPU adapter here: baking on the CPU backend".to_string(),
+                    });
+                    Backend::Cpu
+                }
+            },
         })
     }
 
