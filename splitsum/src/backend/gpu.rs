@@ -177,6 +177,21 @@ impl Gpu {
         Self::matching(backends_from_env(), std::env::var("WGPU_ADAPTER_NAME").ok().as_deref())
     }
 
+    /// Opens the best adapter as [`Gpu::new`] does, unless it is a software rasteriser on
+    /// the CPU (`wgpu::DeviceType::Cpu`: lavapipe, llvmpipe, SwiftShader, WARP): then, or
+    /// where there is no adapter, nothing is opened and the adapter passed over is returned.
+    pub fn unless_software() -> Result<std::result::Result<Self, Option<wgpu::AdapterInfo>>> {
+        let backends = backends_from_env();
+        let instance = instance(backends);
+        let filter = std::env::var("WGPU_ADAPTER_NAME").ok();
+        let Some(adapter) = adapters(&instance, backends, filter.as_deref()).into_iter().next() else { return Ok(Err(None)) };
+        let info = adapter.get_info();
+        if info.device_type == wgpu::DeviceType::Cpu {
+            return Ok(Err(Some(info)));
+        }
+        Self::with_adapter(instance, adapter).map(Ok)
+    }
+
     /// Opens the best adapter on `backends` whose name contains `filter` (any, if `None`).
     pub fn matching(backends: wgpu::Backends, filter: Option<&str>) -> Result<Self> {
         let instance = instance(backends);
@@ -236,14 +251,18 @@ impl Gpu {
         };
         let mut pipelines = HashMap::new();
         // Natively the pipelines are built on every core at once (the driver compiles each;
-        // error scopes are per thread); in a browser, one after another.
+        // error scopes are per thread); in a browser, one after another. On GL too: wgpu
+        // runs every GL call of a device under one lock, which a thread waits for at most
+        // 6 s before it panics (wgpu-hal: "Could not lock adapter context"), and one
+        // kernel's compile can hold it that long on a loaded machine (docs/HAZARDS.md).
         #[cfg(not(target_arch = "wasm32"))]
         let built: Vec<_> = {
             use rayon::prelude::*;
-            kernels.par_iter().map(|k| {
+            let one = |k: &&EntryPoint| {
                 let (pipeline, layout, scope) = build(k);
                 (k.name, pipeline, layout, pollster::block_on(scope.pop()))
-            }).collect()
+            };
+            if info.backend == wgpu::Backend::Gl { kernels.iter().map(one).collect() } else { kernels.par_iter().map(one).collect() }
         };
         #[cfg(target_arch = "wasm32")]
         let built: Vec<_> = {
