@@ -528,14 +528,16 @@ fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
 #[test]
 fn a_larger_budget_never_predicts_more_error() {
     use splitsum::cost::{Machine, for_budget};
+    use splitsum::estimate::{Estimator, Rates};
     let machine = Machine { filtered_reads: 0.25e9, summed_reads: 0.75e9, flops: 18e9 };
+    let estimator = Estimator::new(machine, true, Rates::Measured { seconds: 0.0 });
     let shape = splitsum::InputShape::Equirect { width: 1024, height: 512 };
     let settings = splitsum::Settings::default();
     let cal = Calibration::default();
     let mut last = f64::INFINITY;
     let mut cheapest = f64::INFINITY;
     for budget in [0.01, 0.1, 0.3, 0.5, 1.0, 2.0, 10.0] {
-        let (chosen, error, seconds) = for_budget(&settings, shape, splitsum::Products::ALL, budget, &machine, &cal).expect("a choice");
+        let (chosen, error, seconds) = for_budget(&settings, shape, splitsum::Products::ALL, budget, &estimator, &cal).expect("a choice");
         println!("budget {budget}: {} samples, irradiance {:?}, error {error:.4}, estimate {seconds:.3}", chosen.samples, chosen.irradiance_source);
         assert!(error <= last + 1e-12, "budget {budget}: error {error} above the smaller budget's {last}");
         cheapest = cheapest.min(seconds);

@@ -224,7 +224,7 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     // (estimated on lavapipe's built-in rates, for the levels the plan keeps).
     if let Some(budget) = q.max_seconds {
         let products = Products { specular, irradiance, sh9: false, lut, sheen };
-        let seconds = |job: &splitsum::Job| job.clone().with_levels(levels.clone()).map_or(f64::INFINITY, |j| splitsum::cost::step_seconds(&j, cal, true).total());
+        let seconds = |job: &splitsum::Job| job.clone().with_levels(levels.clone()).map_or(f64::INFINITY, |j| splitsum::cost::step_seconds(&j, true).total());
         let (chosen, error, estimate) = splitsum::cost::for_budget_by(&settings, shape, products, budget, cal, Some(&needed_r), seconds)?;
         let fits = if estimate <= budget { "fits" } else { "is the cheapest measured, over" };
         decide(
@@ -269,9 +269,9 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
 
     let products = Products { specular, irradiance, sh9: false, lut, sheen };
     let job = settings.resolve(shape, products)?.with_levels(levels)?.with_sheen_levels(sheen_levels)?;
-    let cost = estimate(&job, cal);
-    let full_cost = estimate(&settings.resolve(shape, Products::DISPLAY)?, cal);
-    let default_cost = estimate(&Settings::default().resolve(shape, Products::STANDARD)?, cal);
+    let cost = estimate(&job);
+    let full_cost = estimate(&settings.resolve(shape, Products::DISPLAY)?);
+    let default_cost = estimate(&Settings::default().resolve(shape, Products::STANDARD)?);
     Ok(Plan { job, decisions: d, cost, full_cost, default_cost })
 }
 

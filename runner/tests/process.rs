@@ -308,18 +308,23 @@ fn a_16k_hdr_bakes_within_2_gib() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
-/// Off a terminal, every step of a bake says so on stderr as it starts, with the planner's
-/// estimate where it has one (on a terminal, indicatif spinners and bars show the same).
-/// The prefilter's estimate is always shown; the table, embedded and only uploaded, has none.
+/// Off a terminal, every step of a bake says so on stderr as it starts, with its estimate
+/// and how far it may be off where it has one (on a terminal, indicatif spinners and bars
+/// show the same), after a calibration of this device's rates; the timings beside the
+/// estimates at the end. The prefilter's estimate is always shown; the table, embedded and
+/// only uploaded, has none.
 #[test]
 fn each_step_reports_its_start_and_estimate() {
     let d = scratch("steps");
     let o = runner().args(["bake", &courtyard(), "--backend", "cpu", "--size", "128", "--out", d.join("out").to_str().unwrap()]).output().unwrap();
     assert!(o.status.success(), "{}", text(&o));
     let err = String::from_utf8_lossy(&o.stderr);
-    for step in ["reading ", "source cube…", "specular… (estimate ", "irradiance…", "brdf lut…", "writing the files…"] {
+    for step in ["reading ", "calibrating ", "source cube…", "specular… (estimate ", "irradiance…", "brdf lut…", "writing the files…"] {
         assert!(err.lines().any(|l| l.starts_with(step)), "no line starting {step:?}:\n{err}");
     }
+    assert!(err.lines().any(|l| l.starts_with("specular… (estimate ") && l.contains(" ±") && l.ends_with(" %)")), "{err}");
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.lines().any(|l| l.trim_start().starts_with("specular") && l.contains("(estimated ")), "{out}");
 }
 
 /// A small RGB OpenEXR (a gradient, f16) written with `compression` and `blocks`.

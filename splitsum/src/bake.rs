@@ -5,7 +5,8 @@
 //! and the CPU rasteriser. Everything else (plans, caches, the display) calls these.
 
 use crate::backend::{Backend, Kernels, Prefilter, with_kernels};
-use crate::cost::{self, Calibration};
+use crate::cost;
+use crate::estimate::Estimator;
 use crate::environment::Environment;
 use crate::error::{Error, Result};
 use crate::settings::{InputShape, Job, Products, Settings, Step};
@@ -16,13 +17,16 @@ use splitsum_shaders::prefilter::{Lobe, RoughnessMapping};
 use splitsum_shaders::shade::EnvironmentShape;
 use web_time::Instant;
 
-/// Wall time of one step.
+/// Wall time of one step, and what was estimated for it as it started.
 #[derive(Clone, Debug, Serialize)]
 pub struct Timing {
     /// The step.
     pub step: Step,
     /// Seconds.
     pub seconds: f64,
+    /// The estimate shown as the step started (`crate::estimate`), in seconds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimate: Option<f64>,
 }
 
 /// The products of a bake: as a backend made them (`Made<K::Texels>`: host texels, or
@@ -53,21 +57,24 @@ pub struct Made<C, L = C> {
 /// The results of a bake, in host memory.
 pub type Baked = Made<Cube, Lut>;
 
-/// Runs `step` on `k`, estimated at `estimates` (see [`step_estimates`]), with its
-/// progress shown, and records its wall time (until the backend has finished it).
-fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, step: Step, estimates: &cost::Seconds, f: impl FnOnce() -> Result<T>) -> Result<T> {
-    let _progress = crate::progress::step(step.name(), Some(estimates[step]));
+/// Runs `step` of `job` on `k` with its progress and estimate shown, records its wall time
+/// (until the backend has finished it) beside the estimate, and teaches `est` by it.
+fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, step: Step, job: &Job, est: &mut Estimator, f: impl FnOnce() -> Result<T>) -> Result<T> {
+    let estimate = est.step(job, step);
+    let _progress = crate::progress::step(step.name(), Some(estimate));
     let start = Instant::now();
     let r = f()?;
     k.finish()?;
-    timings.push(Timing { step, seconds: start.elapsed().as_secs_f64() });
+    let seconds = start.elapsed().as_secs_f64();
+    est.record(estimate.seconds, seconds);
+    timings.push(Timing { step, seconds, estimate: Some(estimate.seconds) });
     Ok(r)
 }
 
-/// Estimated seconds of each step of `job`, on the GPU (`gpu`) or the CPU (the built-in
-/// calibration: lavapipe, 2 cores).
+/// Estimated seconds of each step of `job` at the built-in rates of lavapipe (`gpu`) or
+/// 2 CPU cores: what the hour limit ([`check_duration`]) refuses by, the same everywhere.
 pub fn step_estimates(gpu: bool, job: &Job) -> cost::Seconds {
-    cost::step_seconds(job, &Calibration::default(), gpu)
+    cost::step_seconds(job, gpu)
 }
 
 /// Runs estimated over this many seconds are refused unless forced.
@@ -126,32 +133,33 @@ pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, job: &Job)
     Ok((k.slice(&full, start, full_layout.texel_count() - start)?, job.source_layout()))
 }
 
-/// Bakes the products of `job` from a source cube already on backend `k`.
-pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout, job: &Job, estimates: &cost::Seconds, mut timings: Vec<Timing>) -> Result<Made<K::Texels>> {
+/// Bakes the products of `job` from a source cube already on backend `k`, each step
+/// estimated by `est`.
+pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout, job: &Job, est: &mut Estimator, mut timings: Vec<Timing>) -> Result<Made<K::Texels>> {
     let p = job.products;
     let specular = if p.specular {
         let pf = prefilter_of(job, Lobe::Ggx);
-        Some(timed(k, &mut timings, Step::Specular, estimates, || k.prefilter(&source, source_layout, &pf))?)
+        Some(timed(k, &mut timings, Step::Specular, job, est, || k.prefilter(&source, source_layout, &pf))?)
     } else {
         None
     };
     let irradiance = if p.irradiance {
-        Some(timed(k, &mut timings, Step::Irradiance, estimates, || k.irradiance(&source, source_layout, job.irradiance_level(), job.irradiance_size))?)
+        Some(timed(k, &mut timings, Step::Irradiance, job, est, || k.irradiance(&source, source_layout, job.irradiance_level(), job.irradiance_size))?)
     } else {
         None
     };
-    let sh9 = if p.sh9 { Some(timed(k, &mut timings, Step::Sh9, estimates, || k.sh9(&source, source_layout, job.sh_level()))?) } else { None };
+    let sh9 = if p.sh9 { Some(timed(k, &mut timings, Step::Sh9, job, est, || k.sh9(&source, source_layout, job.sh_level()))?) } else { None };
     let lut = if p.lut {
         // A constant (`crate::table`): embedded or computed once per process, then uploaded.
-        Some(timed(k, &mut timings, Step::BrdfTable, estimates, || k.upload("brdf table", &crate::table::texels(crate::table::TableKey::of(job))?))?)
+        Some(timed(k, &mut timings, Step::BrdfTable, job, est, || k.upload("brdf table", &crate::table::texels(crate::table::TableKey::of(job))?))?)
     } else {
         None
     };
     let (sheen, sheen_tables) = if p.sheen {
         let pf = prefilter_of(job, Lobe::Charlie);
-        let cube = timed(k, &mut timings, Step::Sheen, estimates, || k.prefilter(&source, source_layout, &pf))?;
+        let cube = timed(k, &mut timings, Step::Sheen, job, est, || k.prefilter(&source, source_layout, &pf))?;
         // Constants, as the BRDF table: computed once per process, then uploaded.
-        let tables = timed(k, &mut timings, Step::SheenTables, estimates, || k.upload("sheen tables", &crate::table::sheen_texels()))?;
+        let tables = timed(k, &mut timings, Step::SheenTables, job, est, || k.upload("sheen tables", &crate::table::sheen_texels()))?;
         (Some(cube), Some(tables))
     } else {
         (None, None)
@@ -169,12 +177,12 @@ fn prefilter_of(job: &Job, lobe: Lobe) -> Prefilter<'_> {
     Prefilter { lobe, layout: job.specular_layout(), roughness, levels, samples: &job.samples_per_mip, exact, lod_bias: job.lod_bias }
 }
 
-/// Bakes `job` from `env` on backend `k`, leaving the products there.
-pub fn make<K: Kernels>(k: &K, gpu: bool, env: &Environment, job: &Job) -> Result<Made<K::Texels>> {
-    let est = step_estimates(gpu, job);
+/// Bakes `job` from `env` on backend `k`, leaving the products there; each step
+/// estimated by `est`.
+pub fn make<K: Kernels>(k: &K, est: &mut Estimator, env: &Environment, job: &Job) -> Result<Made<K::Texels>> {
     let mut timings = Vec::new();
-    let (source, layout) = timed(k, &mut timings, Step::SourceCube, &est, || source_cube(k, env, job))?;
-    self::products(k, source, layout, job, &est, timings)
+    let (source, layout) = timed(k, &mut timings, Step::SourceCube, job, est, || source_cube(k, env, job))?;
+    self::products(k, source, layout, job, est, timings)
 }
 
 /// `made` read into host memory.
@@ -198,10 +206,13 @@ pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products:
     bake_job(backend, env, &job)
 }
 
-/// Bakes `job` (resolved for `env`) on `backend`, into host memory.
+/// Bakes `job` (resolved for `env`) on `backend`, into host memory; its steps estimated by
+/// `backend`'s estimator (`crate::estimate::for_backend`), which learns from them.
 pub fn bake_job(backend: &Backend, env: &Environment, job: &Job) -> Result<Baked> {
-    let gpu = backend.is_gpu();
-    with_kernels!(backend, k => read(k, make(k, gpu, env, job)?, job))
+    let mut est = crate::estimate::for_backend(backend)?;
+    let baked = with_kernels!(backend, k => read(k, make(k, &mut est, env, job)?, job));
+    crate::estimate::keep(backend, est);
+    baked
 }
 
 /// A 1×1 cube of zeros: the stand-in for a product a plan leaves out (nothing reads it).

@@ -1,15 +1,16 @@
-//! What a bake costs before it runs: the error model and cost rates a plan chooses from
-//! ([`Calibration`]), and the time and memory of a resolved bake ([`estimate`],
-//! [`step_seconds`]).
+//! What a bake costs before it runs: the error model a plan chooses from ([`Calibration`]),
+//! each step's work by kind ([`step_work`]) and a device's limits on each kind
+//! ([`measure_machine`]), which `crate::estimate` turns into seconds, and the time and
+//! memory of a resolved bake at the built-in rates ([`estimate`], [`step_seconds`]).
 
 use crate::measured::{Knob, Measurement, Method, Part, Product};
 use crate::settings::{InputShape, Job, Step, TableMethod};
 use serde::Serialize;
 
-/// Error of each product against its reference, per setting, and the cost rates of each
-/// backend: what the planner chooses from. The built-in one is `runner report` on the two
-/// vendored HDRIs with a 34 000 sun and without (the worse of the two), on lavapipe and
-/// on 2 CPU cores, November 2026.
+/// Error of each product against its reference, per setting: what the planner chooses
+/// from. The built-in one is `runner report` on the two vendored HDRIs with a 34 000 sun
+/// and without (the worse of the two), on 2 CPU cores, November 2026. (What each choice
+/// costs is `crate::estimate`'s.)
 #[derive(Clone, Debug, Serialize)]
 pub struct Calibration {
     /// Where the numbers come from.
@@ -20,25 +21,12 @@ pub struct Calibration {
     pub prefilter: Vec<(f32, Vec<(u32, f64)>)>,
     /// Irradiance convolution: (source face size, mean relative error).
     pub irradiance: Vec<(u32, f64)>,
-    /// Nanoseconds per unit of work on (lavapipe, CPU), per step (see `work`).
-    pub ns: Rates,
-}
-
-/// Nanoseconds per unit of work of each step on (lavapipe, CPU).
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct Rates(pub [(f64, f64); 7]);
-
-impl std::ops::Index<Step> for Rates {
-    type Output = (f64, f64);
-    fn index(&self, s: Step) -> &(f64, f64) {
-        &self.0[Step::ALL.iter().position(|x| *x == s).expect("every step is listed")]
-    }
 }
 
 impl Default for Calibration {
     fn default() -> Self {
         Self {
-            source: "built in: runner report on city.exr and courtyard.exr (the worse of the two), runner bench, lavapipe and 2 CPU cores".into(),
+            source: "built in: runner report on city.exr and courtyard.exr (the worse of the two), 2 CPU cores".into(),
             // Bands [0.02, 0.05) … [0.75, 1] of `runner report` on city.exr and courtyard.exr
             // (the worse of the two), CPU backend.
             prefilter: vec![
@@ -51,22 +39,13 @@ impl Default for Calibration {
                 (0.875, vec![(16, 0.0383), (64, 0.0353), (256, 0.0269)]),
             ],
             irradiance: vec![(4, 0.035), (8, 0.0181), (16, 0.0067), (32, 0.00168), (64, 0.00083)],
-            // Rates from `runner bench` of the defaults on city.exr (December 2026): 3.5 M
-            // equirect supersamples in 0.10 s / 0.10 s, 12.2 M prefilter samples in 0.31 s /
-            // 0.32 s, 9.4 M irradiance texel pairs in 0.035 s / 0.010 s. An SH9 texel (nine
-            // basis functions, one weighted add each) is taken at an irradiance pair's rate.
-            // A table other than the embedded one is integrated once per process on the CPU
-            // (`crate::table`), 36 M evaluations in 0.33 s, whichever backend bakes.
-            // The sheen cube is taken at the specular cube's rate per sample (the same
-            // loop); its tables are embedded, uploaded like the BRDF table.
-            ns: Rates([(28.0, 29.0), (25.0, 26.0), (3.7, 1.1), (3.7, 1.1), (9.1, 9.1), (25.0, 26.0), (9.1, 9.1)]),
         }
     }
 }
 
 impl Calibration {
     /// The error model from `report.csv` of `runner report` (its first backend's rows),
-    /// keeping the built-in cost rates; `None` if the text is not such a file or lacks
+    /// `None` if the text is not such a file or lacks
     /// the rows of a product.
     pub fn from_report_csv(text: &str) -> Option<Self> {
         Self::from_measurements(&crate::measured::read_csv(text).ok()?)
@@ -76,7 +55,7 @@ impl Calibration {
     /// the irradiance convolution's error per source size, and the bake's share of the
     /// shaded colour's error per roughness band and sample count, for the defaults.
     pub fn from_measurements(rows: &[Measurement]) -> Option<Self> {
-        let mut c = Calibration { source: "report.csv".into(), prefilter: vec![], irradiance: vec![], ..Default::default() };
+        let mut c = Calibration { source: "report.csv".into(), prefilter: vec![], irradiance: vec![] };
         let backend = &rows.iter().find(|r| !r.backend.is_empty())?.backend;
         for r in rows.iter().filter(|r| &r.backend == backend) {
             match (r.product, r.method, r.part) {
@@ -183,79 +162,48 @@ impl PerStep {
     }
 }
 
-/// Units of work of each step (equirect supersamples, prefilter samples or an eighth of
-/// an exact sum's terms, irradiance texel pairs, SH9 texels, BRDF table evaluations) of
-/// `job`, and the bytes of its products in memory.
-fn work(job: &Job) -> (PerStep, u64) {
-    let mut work = PerStep::default();
-    let mut bytes = 0u64;
-    let source = job.source_layout();
-    if let InputShape::Equirect { .. } | InputShape::Unknown = job.input {
-        work[Step::SourceCube] = 6.0 * (job.source_size as f64).powi(2) * (job.supersample as f64).powi(2);
-    }
-    bytes += source.texel_count() as u64 * 16;
+/// The bytes of `job`'s products in memory (each prefiltered level with its sums, the
+/// tables, the irradiance with its sums) and of its source cube.
+fn product_bytes(job: &Job) -> u64 {
+    let mut bytes = job.source_layout().texel_count() as u64 * 16;
     for cube in prefiltered_cubes(job) {
-        let out = job.specular_layout();
         for &l in cube.levels {
-            let texels = 6.0 * (out.level_size(l) as f64).powi(2);
-            let r = cube.roughness[l as usize];
-            if !cube.lobe.is_mirror(r) {
-                // An exact sum's 6t² terms cost about an eighth of a sample each.
-                let per_texel = if cube.exact[l as usize] != splitsum_shaders::prefilter::SAMPLED {
-                    6.0 * (source.level_size(cube.exact[l as usize]) as f64).powi(2) / 8.0
-                } else {
-                    job.samples_per_mip[l as usize] as f64
-                };
-                work[cube.step] += texels * per_texel;
-            }
             // The sums (3 × RGBA per texel) and the result.
-            bytes += texels as u64 * 64;
+            bytes += 6 * (job.specular_layout().level_size(l) as u64).pow(2) * 64;
         }
     }
     if job.products.sheen {
-        // The sheen tables are embedded (`crate::table`): uploaded, not integrated.
         bytes += (crate::table::SHEEN_TABLE_SIZE as u64).pow(2) * 24;
     }
     if job.products.lut {
-        // The embedded table is uploaded, not integrated (`crate::table`).
-        let per_texel = match job.lut_method {
-            _ if crate::table::TableKey::of(job) == crate::table::TableKey::EMBEDDED => 0,
-            TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
-            TableMethod::Sampled => job.lut_samples,
-        };
-        work[Step::BrdfTable] = (job.lut_size as f64).powi(2) * per_texel as f64;
         bytes += (job.lut_size as u64).pow(2) * 24;
     }
     if job.products.irradiance {
-        work[Step::Irradiance] = 6.0 * (job.irradiance_size as f64).powi(2) * 6.0 * (job.irradiance_source as f64).powi(2);
         bytes += 6 * (job.irradiance_size as u64).pow(2) * 64;
     }
-    if job.products.sh9 {
-        work[Step::Sh9] = 6.0 * (job.sh_source as f64).powi(2);
-    }
-    (work, bytes)
+    bytes
 }
 
-/// Estimated seconds of each step of `job`, on lavapipe (`gpu`) or on 2 CPU cores.
-pub fn step_seconds(job: &Job, cal: &Calibration, gpu: bool) -> Seconds {
-    let (work, _) = work(job);
+/// Estimated seconds of each step of `job` at the built-in rates of lavapipe (`gpu`) or
+/// 2 CPU cores, measured quiet (`crate::estimate::Estimator::built_in`): what the planner
+/// compares and the hour limit refuses, the same on every machine.
+pub fn step_seconds(job: &Job, gpu: bool) -> Seconds {
     let mut out = PerStep::default();
-    for s in Step::ALL {
-        let (g, c) = cal.ns[s];
-        out[s] = work[s] * if gpu { g } else { c } * 1e-9;
+    for (step, e) in crate::estimate::Estimator::built_in(gpu).steps(job) {
+        out[step] = e.seconds;
     }
     out
 }
 
-/// Estimated time and memory of `job`: the products and their sums, plus the environment
-/// as read (RGBA f32, with its row pyramid: `12·width²` bytes).
-pub fn estimate(job: &Job, cal: &Calibration) -> Cost {
-    let (_, bytes) = work(job);
+/// Estimated time (at the built-in rates, [`step_seconds`]) and memory of `job`: the
+/// products and their sums, plus the environment as read (RGBA f32, with its row pyramid:
+/// `12·width²` bytes).
+pub fn estimate(job: &Job) -> Cost {
     let width = match job.input {
         InputShape::Equirect { width, .. } => width as u64,
         _ => 0,
     };
-    Cost { gpu_seconds: step_seconds(job, cal, true).total(), cpu_seconds: step_seconds(job, cal, false).total(), bytes: bytes + 12 * width.pow(2) }
+    Cost { gpu_seconds: step_seconds(job, true).total(), cpu_seconds: step_seconds(job, false).total(), bytes: product_bytes(job) + 12 * width.pow(2) }
 }
 
 /// The work of one step, by kind: what the cost model of `runner bench` counts.
@@ -414,15 +362,68 @@ impl Machine {
     }
 }
 
+/// How long the calibration kernel runs for a [`measure_machine`], and by which clock.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub struct Calibrating {
+    /// Seconds of one timed run of each kind of work (the work is doubled until a run
+    /// takes half of it: these runs warm the pipeline and caches).
+    pub run_seconds: f64,
+    /// Timed runs of each kind; the fastest is kept.
+    pub runs: u32,
+    /// How a run is timed.
+    pub clock: Clock,
+}
+
+/// How a calibration run is timed.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Clock {
+    /// Wall time: what the device does now, whatever else runs.
+    Wall,
+    /// The processor time this process spent, over the `threads` that do the work: what
+    /// the device does with the processors to itself, whatever else runs (on a loaded
+    /// machine, wall time over runs of a few milliseconds is either a lucky unloaded run or
+    /// a preempted one; `crate::estimate` measures the share of the processors this process
+    /// gets apart). Where a process's time is not known (a browser), wall time.
+    Cpu {
+        /// The threads that run the work (rayon's, or the software driver's).
+        threads: u32,
+    },
+}
+
+impl Calibrating {
+    /// `runner bench`'s limits: runs of 50 ms by the wall clock, the fastest of four.
+    pub const THOROUGH: Calibrating = Calibrating { run_seconds: 0.05, runs: 4, clock: Clock::Wall };
+}
+
+/// The processor time this process has used (user and system, every thread), in seconds.
+pub fn process_cpu_seconds() -> Option<f64> {
+    #[cfg(all(unix, not(target_arch = "wasm32")))]
+    {
+        let mut usage = std::mem::MaybeUninit::<libc::rusage>::zeroed();
+        // SAFETY: getrusage writes the struct it is given; RUSAGE_SELF is always valid.
+        if unsafe { libc::getrusage(libc::RUSAGE_SELF, usage.as_mut_ptr()) } != 0 {
+            return None;
+        }
+        // SAFETY: initialised by the successful call.
+        let u = unsafe { usage.assume_init() };
+        let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
+        Some(t(u.ru_utime) + t(u.ru_stime))
+    }
+    #[cfg(not(all(unix, not(target_arch = "wasm32"))))]
+    None
+}
+
 /// Runs the calibration kernel on `backend` and returns its rates: each kind of work on a
-/// 128² cube with its mip chain (values from a fixed hash, positive and finite), timed
-/// after a first run that warms the pipeline and caches; the fastest of four runs is kept.
-pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Result<Machine> {
+/// 128² cube with its mip chain (values from a fixed hash, positive and finite), the work
+/// per run doubled (in steps per texel up to `math::CHUNK`, then in texels) until a run
+/// takes half of `how.run_seconds`, then timed `how.runs` times by `how.clock`; the fastest
+/// run is kept.
+pub fn measure_machine(backend: &crate::backend::Backend, how: Calibrating) -> crate::error::Result<Machine> {
     use crate::backend::{Backend, Kernels};
     use splitsum_shaders::calibrate::Rate;
     use splitsum_shaders::cubemap::CubeLayout;
     use splitsum_shaders::glam::Vec4;
-    fn rate<K: Kernels>(k: &K, rate: Rate, size: u32, count: u32) -> crate::error::Result<f64> {
+    fn rate<K: Kernels>(k: &K, rate: Rate, how: Calibrating) -> crate::error::Result<f64> {
         let layout = CubeLayout::new(128, CubeLayout::full_chain(128));
         let texels: Vec<Vec4> = (0..layout.texel_count())
             .map(|i| {
@@ -431,40 +432,47 @@ pub fn measure_machine(backend: &crate::backend::Backend) -> crate::error::Resul
             })
             .collect();
         let src = k.upload("calibration cube", &texels)?;
-        let mut best = f64::INFINITY;
-        for run in 0..5 {
+        // (wall seconds, seconds by `how.clock`)
+        let run = |size: u32, count: u32| -> crate::error::Result<(f64, f64)> {
             k.finish()?;
+            let cpu = process_cpu_seconds();
             let t = web_time::Instant::now();
             let out = k.calibrate(&src, layout, rate, size, count)?;
             k.finish()?;
-            if run > 0 {
-                best = best.min(t.elapsed().as_secs_f64());
-            }
+            let wall = t.elapsed().as_secs_f64();
+            let timed = match (how.clock, cpu, process_cpu_seconds()) {
+                (Clock::Cpu { threads }, Some(a), Some(b)) => (b - a) / threads.max(1) as f64,
+                _ => wall,
+            };
             drop(out);
+            Ok((wall, timed))
+        };
+        // Lavapipe stops an invocation's loops after 65 535 iterations (docs/HAZARDS.md):
+        // at most one chunk of steps per texel, then more texels.
+        let (mut size, mut count) = (16u32, 16u32);
+        while run(size, count)?.0 < 0.5 * how.run_seconds && size < 512 {
+            if count < splitsum_shaders::math::CHUNK { count *= 2 } else { size *= 2 }
         }
-        Ok(6.0 * (size as f64).powi(2) * count as f64 * rate.per_step() as f64 / best)
+        let mut best = f64::INFINITY;
+        for _ in 0..how.runs.max(1) {
+            best = best.min(run(size, count)?.1);
+        }
+        Ok(6.0 * (size as f64).powi(2) * count as f64 * rate.per_step() as f64 / best.max(1e-9))
     }
-    let measure = |k: &dyn Fn(Rate, u32, u32) -> crate::error::Result<f64>| -> crate::error::Result<Machine> {
-        Ok(Machine { filtered_reads: k(Rate::Filtered, 64, 128)?, summed_reads: k(Rate::Summed, 32, 8192)?, flops: k(Rate::Arithmetic, 64, 1024)? })
+    let measure = |k: &dyn Fn(Rate) -> crate::error::Result<f64>| -> crate::error::Result<Machine> {
+        Ok(Machine { filtered_reads: k(Rate::Filtered)?, summed_reads: k(Rate::Summed)?, flops: k(Rate::Arithmetic)? })
     };
     match backend {
-        Backend::Gpu(g) => measure(&|r, s, c| rate(&**g, r, s, c)),
-        Backend::Cpu => measure(&|r, s, c| rate(&crate::backend::Cpu, r, s, c)),
+        Backend::Gpu(g) => measure(&|r| rate(&**g, r, how)),
+        Backend::Cpu => measure(&|r| rate(&crate::backend::Cpu, r, how)),
     }
 }
 
-/// The share of its limits a bake reaches, for turning the cost model's limits into a time
-/// estimate on a device measured only by the calibration kernel: a little under what the
-/// default bake of city.exr reaches as a whole (`runner bench`, December 2026: the sum of
-/// its steps' limits over its time, 0.66 on lavapipe and 0.69 on 2 CPU cores).
-pub const SHARE_OF_LIMIT: f64 = 0.6;
-
-/// The settings a bake within `budget` seconds on `machine` should use: [`for_budget_by`]
-/// over every calibrated roughness band, each candidate's time estimated from the cost
-/// model's limits on `machine` at [`SHARE_OF_LIMIT`].
-pub fn for_budget(given: &crate::settings::Settings, shape: InputShape, products: crate::settings::Products, budget: f64, machine: &Machine, cal: &Calibration) -> crate::error::Result<(crate::settings::Settings, f64, f64)> {
-    let seconds = |job: &Job| step_work(job).iter().map(|(_, w)| machine.limit(w).0).sum::<f64>() / SHARE_OF_LIMIT;
-    for_budget_by(given, shape, products, budget, cal, None, seconds)
+/// The settings a bake within `budget` seconds should use, with their estimated seconds
+/// by `estimator` (this device's measured rates): [`for_budget_by`] over every calibrated
+/// roughness band.
+pub fn for_budget(given: &crate::settings::Settings, shape: InputShape, products: crate::settings::Products, budget: f64, estimator: &crate::estimate::Estimator, cal: &Calibration) -> crate::error::Result<(crate::settings::Settings, f64, f64)> {
+    for_budget_by(given, shape, products, budget, cal, None, |job| estimator.total(job))
 }
 
 /// The one search for a time budget: among the specular sample counts and irradiance

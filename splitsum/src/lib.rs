@@ -73,6 +73,7 @@ internal_modules! {
     bake;
     cache;
     cost;
+    estimate;
     files;
     host;
     ktx1;

@@ -1,5 +1,5 @@
-//! Progress on stderr. Every step of a bake shows a spinner with its elapsed time and the
-//! planner's estimate (`plan::step_seconds`), and the CPU backend's long loops a bar under
+//! Progress on stderr. Every step of a bake shows a spinner with its elapsed time and its
+//! estimate with how far it may be off (`crate::estimate`), and the CPU backend's long loops a bar under
 //! it; all are drawn by one `indicatif::MultiProgress`. Where stderr is not a terminal
 //! (CI logs, pipes), bars are hidden and each step prints one line as it starts instead.
 //!
@@ -20,7 +20,8 @@ pub fn show(on: bool) {
     SHOWN.store(on, Ordering::Relaxed);
 }
 
-fn shown() -> bool {
+/// Whether progress is shown (the command line turned it on).
+pub fn shown() -> bool {
     SHOWN.load(Ordering::Relaxed)
 }
 
@@ -56,10 +57,12 @@ pub fn bar(what: &str, len: u64) -> ProgressBar {
 /// never touches one).
 pub struct Step(Option<ProgressBar>);
 
-/// Starts step `what`, estimated to take `estimate` seconds (if known).
-pub fn step(what: &str, estimate: Option<f64>) -> Step {
+/// Starts step `what`, estimated to take `estimate` (if known): shown with how far it may
+/// be off where the estimate comes from this device's rates, alone where it does not.
+pub fn step(what: &str, estimate: Option<crate::estimate::Estimate>) -> Step {
     let est = match estimate {
-        Some(s) if s >= 0.05 => format!(" (estimate {})", seconds(s)),
+        Some(e) if e.seconds >= crate::estimate::SHOWN && e.within.is_finite() => format!(" (estimate {} ±{:.0} %)", seconds(e.seconds), 100.0 * e.within),
+        Some(e) if e.seconds >= crate::estimate::SHOWN => format!(" (estimate {}, at built-in rates)", seconds(e.seconds)),
         _ => String::new(),
     };
     if !shown() {
@@ -85,9 +88,11 @@ impl Drop for Step {
     }
 }
 
-/// `s` seconds in words: `0.4 s`, `12 s`, `3.2 min`, `5.1 h`, `12 days`.
+/// `s` seconds in words: `0.04 s`, `2.4 s`, `12 s`, `3.2 min`, `5.1 h`, `12 days`.
 pub fn seconds(s: f64) -> String {
-    if s < 10.0 {
+    if s < 1.0 {
+        format!("{s:.2} s")
+    } else if s < 10.0 {
         format!("{s:.1} s")
     } else if s < 120.0 {
         format!("{s:.0} s")

@@ -15,6 +15,7 @@
 
 use crate::backend::{Cpu, Gpu, Kernels, gpu, gpu::Texels};
 use crate::bake::{self, Baked, Made, Timing};
+use crate::estimate::Estimator;
 use crate::environment::Environment;
 use crate::error::{Error, Result};
 use crate::settings::{InputShape, Job, Products, Settings, Step};
@@ -164,15 +165,15 @@ impl Baker {
         match &self.gpu {
             Some(g) => {
                 let made = match source {
-                    Source::Environment(env) => bake::make(g, true, env, &job)?,
+                    Source::Environment(env) => bake::make(g, &mut Estimator::built_in(true), env, &job)?,
                     Source::Texture(t) => {
-                        let est = bake::step_estimates(true, &job);
+                        let mut est = Estimator::built_in(true);
                         let mut timings = Vec::new();
                         let start = web_time::Instant::now();
                         let (src, layout) = texture_source_cube(g, t, &job)?;
                         g.finish()?;
-                        timings.push(Timing { step: Step::SourceCube, seconds: start.elapsed().as_secs_f64() });
-                        bake::products(g, src, layout, &job, &est, timings)?
+                        timings.push(Timing { step: Step::SourceCube, seconds: start.elapsed().as_secs_f64(), estimate: None });
+                        bake::products(g, src, layout, &job, &mut est, timings)?
                     }
                 };
                 self.gpu_textures(g, made, &job)
@@ -186,7 +187,7 @@ impl Baker {
                         &owned
                     }
                 };
-                let made = bake::make(&Cpu, false, env, &job)?;
+                let made = bake::make(&Cpu, &mut Estimator::built_in(false), env, &job)?;
                 let baked = bake::read(&Cpu, made, &job)?;
                 Ok(self.upload(&baked, &job))
             }

@@ -62,6 +62,7 @@ fn products_of(settings: &splitsum::Settings, sheen: bool) -> anyhow::Result<spl
 }
 
 pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
+    let started = Instant::now();
     if let Some(scene_path) = &args.scene.scene {
         if !args.env.is_empty() {
             return Err(Usage::new("give either ENV or --scene, not both (the scene names its environment)").into());
@@ -94,7 +95,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let (env, input) = read?;
     let backend = backend?;
     if let Some(budget) = args.budget {
-        settings = within_budget(&settings, InputShape::of(&env), products, budget, &backend, given)?;
+        settings = within_budget(&settings, InputShape::of(&env), products, budget, &backend, given, started)?;
     }
     let job = settings.resolve(InputShape::of(&env), products)?;
     bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.scene.force)?;
@@ -106,9 +107,17 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let about = output::About { environment: env_path.display().to_string(), backend: backend.describe(), input: Some(input) };
     let manifest = write_bake(out, &baked, &job, about)?;
     for t in &manifest.timings {
-        println!("  {:<12} {:>9.3} s", t.step.name(), t.seconds);
+        match t.estimate {
+            Some(e) if e >= splitsum::estimate::SHOWN || t.seconds >= splitsum::estimate::SHOWN => {
+                println!("  {:<12} {:>9.3} s (estimated {e:.3} s)", t.step.name(), t.seconds)
+            }
+            _ => println!("  {:<12} {:>9.3} s", t.step.name(), t.seconds),
+        }
     }
     println!("  {:<12} {:>9.3} s", "total", manifest.timings.iter().map(|t| t.seconds).sum::<f64>());
+    if let Some(budget) = args.budget {
+        println!("budget {budget} s: this run took {:.2} s until its files were written", started.elapsed().as_secs_f64());
+    }
     if let Some(e) = manifest.sh9_vs_convolution {
         println!(
             "  sh9.json (9 coefficients, a band-limited stand-in for irradiance.ktx2) against the convolution: max relative error {:.1} %, rms {:.1} % over the irradiance texels; small bright sources exceed what 9 coefficients hold, prefer irradiance.ktx2",
@@ -120,9 +129,20 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     Ok(())
 }
 
-/// The settings for a bake within `budget` seconds on `backend` (`splitsum::cost::for_budget`),
-/// stated; refuses `--budget` beside a flag it would choose.
-fn within_budget(settings: &splitsum::Settings, shape: InputShape, products: splitsum::Products, budget: f64, backend: &Backend, given: &[String]) -> anyhow::Result<splitsum::Settings> {
+/// The settings for a bake within `budget` seconds of this run on `backend`
+/// (`splitsum::cost::for_budget`, by this device's estimator), stated; refuses `--budget`
+/// beside a flag it would choose. The budget counts what the run has spent since `started`
+/// (starting the device, reading the input, the calibration of the estimator): the bake
+/// gets what is left. Writing the files comes after and is not counted (it is said so).
+fn within_budget(
+    settings: &splitsum::Settings,
+    shape: InputShape,
+    products: splitsum::Products,
+    budget: f64,
+    backend: &Backend,
+    given: &[String],
+    started: Instant,
+) -> anyhow::Result<splitsum::Settings> {
     if !(budget > 0.0 && budget.is_finite()) {
         return Err(Usage::new(format!("--budget must be a positive number of seconds, not {budget}")).into());
     }
@@ -131,15 +151,20 @@ fn within_budget(settings: &splitsum::Settings, shape: InputShape, products: spl
             return Err(Usage::new(format!("--budget chooses {f} itself: give one or the other")).into());
         }
     }
-    let machine = splitsum::cost::measure_machine(backend)?;
-    let (chosen, error, seconds) = splitsum::cost::for_budget(settings, shape, products, budget, &machine, &splitsum::cost::Calibration::default())?;
-    let fits = if seconds <= budget { "fits" } else { "is the cheapest, and still over" };
+    let estimator = splitsum::estimate::for_backend(backend)?;
+    let spent = started.elapsed().as_secs_f64();
+    let left = budget - spent;
+    let (chosen, error, seconds) = splitsum::cost::for_budget(settings, shape, products, left.max(0.0), &estimator, &splitsum::cost::Calibration::default())?;
+    let within = estimator.steps(&chosen.resolve(shape, products)?).iter().map(|(_, e)| e.within).fold(0.0, f64::max);
+    let fits = if seconds <= left { "fits" } else { "is the cheapest, and still over" };
     println!(
-        "budget {budget} s on {}: {} samples at mip 1, irradiance from {}², predicted error {:.1} %, estimated {seconds:.3} s ({fits} the budget)",
+        "budget {budget} s on {}: {spent:.2} s went to starting the device, reading the input and measuring its rates; {} samples at mip 1, irradiance from {}², predicted error {:.1} %, bake estimated {seconds:.2} s ±{:.0} % ({fits} the {:.2} s left; writing the files comes after)",
         backend.describe(),
         chosen.samples,
         chosen.irradiance_source.unwrap_or_default(),
-        100.0 * error
+        100.0 * error,
+        100.0 * within,
+        left.max(0.0)
     );
     Ok(chosen)
 }

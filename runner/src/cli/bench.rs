@@ -1,6 +1,6 @@
-//! `runner bench`: bake time per step on each backend against the cost model (each step's
-//! work counted from the job, the device's limits measured by the calibration kernel),
-//! and peak memory.
+//! `runner bench`: bake time per step on each backend against its estimate (as the
+//! progress showed it) and against the cost model (each step's work counted from the job,
+//! the device's limits measured by the calibration kernel), and peak memory.
 
 use super::*;
 use crate::bake;
@@ -59,6 +59,9 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
             }
         };
         bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.force)?;
+        // The fastest run of each step, with the estimate shown as that run's step started
+        // (the estimator learns from every run: later runs are estimated by what the
+        // earlier ones took, as in a batch).
         let mut best: Vec<bake::Timing> = Vec::new();
         for _ in 0..args.runs.max(1) {
             let baked = bake::bake_job(&backend, &env, &job)?;
@@ -66,28 +69,39 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 best = baked.timings;
             } else {
                 for (b, t) in best.iter_mut().zip(baked.timings) {
-                    b.seconds = b.seconds.min(t.seconds);
+                    if t.seconds < b.seconds {
+                        *b = t;
+                    }
                 }
             }
         }
         println!("{}", backend.describe());
-        let machine = splitsum::cost::measure_machine(&backend)?;
+        let machine = splitsum::cost::measure_machine(&backend, splitsum::cost::Calibrating::THOROUGH)?;
         println!(
             "  limits by the calibration kernel: {:.2} G filtered texel reads/s, {:.2} G summed texel reads/s, {:.1} GFLOP/s",
             machine.filtered_reads * 1e-9,
             machine.summed_reads * 1e-9,
             machine.flops * 1e-9
         );
-        println!("  {:<12} {:>9} {:>10} {:>10} {:>9} {:>8} {:>10} {:>9}  bound by", "step", "seconds", "filt. M", "summ. M", "GFLOP", "MB", "limit s", "of limit");
+        println!(
+            "  {:<12} {:>9} {:>10} {:>7} {:>10} {:>10} {:>9} {:>8} {:>10} {:>9}  bound by",
+            "step", "seconds", "estimate", "off", "filt. M", "summ. M", "GFLOP", "MB", "limit s", "of limit"
+        );
         let work = splitsum::cost::step_work(&job);
         for t in &best {
             let w = work.iter().find(|(s, _)| *s == t.step).expect("every step").1;
             let (limit, bound) = machine.limit(&w);
             let fraction = if t.seconds > 0.0 && limit > 0.0 { format!("{:.0} %", 100.0 * limit / t.seconds) } else { "-".into() };
+            let (estimate, off) = match t.estimate {
+                Some(e) => (format!("{e:.3}"), if t.seconds > 0.0 { format!("{:+.0} %", 100.0 * (e / t.seconds - 1.0)) } else { "-".into() }),
+                None => ("-".into(), "-".into()),
+            };
             println!(
-                "  {:<12} {:>9.3} {:>10.1} {:>10.1} {:>9.2} {:>8.1} {:>10.4} {:>9}  {}",
+                "  {:<12} {:>9.3} {:>10} {:>7} {:>10.1} {:>10.1} {:>9.2} {:>8.1} {:>10.4} {:>9}  {}",
                 t.step.name(),
                 t.seconds,
+                estimate,
+                off,
                 w.filtered_reads * 1e-6,
                 w.summed_reads * 1e-6,
                 w.flops * 1e-9,
@@ -102,7 +116,8 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
             println!("  budget-to-error curve (predicted error: the built-in error model, end to end)");
             println!("  {:>9} {:>8} {:>11} {:>10} {:>11} {:>10}", "budget s", "samples", "irradiance", "error", "estimate s", "bake s");
             for &budget in &args.budgets {
-                let (chosen, error, estimate) = splitsum::cost::for_budget(&settings, InputShape::of(&env), products, budget, &machine, &splitsum::cost::Calibration::default())?;
+                let estimator = splitsum::estimate::for_backend(&backend)?;
+                let (chosen, error, estimate) = splitsum::cost::for_budget(&settings, InputShape::of(&env), products, budget, &estimator, &splitsum::cost::Calibration::default())?;
                 let job = chosen.resolve(InputShape::of(&env), products)?;
                 let seconds: f64 = bake::bake_job(&backend, &env, &job)?.timings.iter().map(|t| t.seconds).sum();
                 println!("  {budget:>9} {:>8} {:>10}² {:>9.1} % {estimate:>11.3} {seconds:>10.3}", chosen.samples, job.irradiance_source, 100.0 * error);

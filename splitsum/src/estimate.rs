@@ -1,0 +1,297 @@
+//! What each step of a bake will take on the device at hand, and how sure that is: the
+//! progress shows it as each step starts, `runner bake` and `runner bench` beside the time
+//! measured, and `--budget` chooses by it.
+//!
+//! The cost model counts each step's work by kind (`cost::step_work`: filtered texel reads,
+//! summed texel reads, floating-point operations) and the calibration kernel measures what
+//! the device does per second of each kind *now*, under whatever load the machine carries
+//! (`cost::measure_machine`, about 0.1 s before the first bake of a process on 2 CPU
+//! cores, 0.3 s on lavapipe).
+//! The least time a step can take is its slowest kind of work at those rates (its limit);
+//! a step reaches a share of that limit that depends on its code more than on the device
+//! or the load, so
+//!
+//! ```text
+//!     estimate(step) = limit(step) / share(step) · c
+//! ```
+//!
+//! where the limit is at the rates the device reaches unloaded, divided by the share of the
+//! processors this process gets now where the work runs on them ([`availability`]), the
+//! shares measured by `runner bench` here ([`SHARES_CPU`], [`SHARES_GPU`]), and `c`
+//! the geometric mean of measured/estimated over the steps already done in this process,
+//! shrunk towards 1 as if one more step had been exactly right: a load that changes after
+//! the calibration moves the later estimates with it. How sure: before any step has been
+//! timed, the model's own spread over the configurations the shares were measured on
+//! ([`MODEL_SPREAD`]); after, the larger of that and how far the steps done were off.
+
+use crate::cost::{Machine, step_work};
+use crate::settings::{Job, Step};
+
+/// The share of its limit each step reaches, in the order of [`Step::ALL`], on 2 CPU cores:
+/// the median of limit/time over five quiet `runner bench --runs 1` of city.exr, with and
+/// without `--sheen` (the tuning set; each a process of its own, calibrated as a bake is,
+/// December 2026), confirmed on four held-out configurations (courtyard.exr, studio.exr at
+/// 512², sunset.exr at 128², forest.exr for the khronos target). The irradiance and SH9
+/// steps take under 50 ms here (no estimate is shown or learnt from): the summed reads'
+/// share of lavapipe, rounded. The tables are uploaded constants: no work the limits
+/// measure, no share.
+pub const SHARES_CPU: [f64; 7] = [0.52, 1.01, 0.6, 0.6, 1.0, 1.25, 1.0];
+
+/// The same on a GPU: measured on lavapipe, likewise (no hardware GPU has been measured).
+pub const SHARES_GPU: [f64; 7] = [0.41, 0.76, 0.67, 0.67, 1.0, 0.70, 1.0];
+
+/// How far a step's estimate may be off before any step of this process has been timed,
+/// on a quiet machine: the 90th percentile of |estimate/measured − 1| over the steps shown
+/// in three quiet runs of the six configurations on both backends (32 %, 96 steps).
+pub const MODEL_SPREAD: f64 = 0.3;
+
+/// The same where the process gets less than [`LOADED`] of its processors: the 90th
+/// percentile with `stress-ng --cpu 4` beside the runs (51 %, 107 steps).
+pub const LOADED_SPREAD: f64 = 0.5;
+
+/// The share of its processors below which the machine counts as loaded.
+pub const LOADED: f64 = 0.8;
+
+/// Steps shorter than this (seconds) teach the estimator nothing: their time is mostly
+/// fixed costs (a dispatch, an upload, a scheduler's slice) the limits do not model.
+pub const SHORTEST: f64 = 0.05;
+
+/// Steps estimated under this (seconds) show no estimate: under load such a step either
+/// runs within one slice of the scheduler or waits for the next, and is off by up to 3×.
+pub const SHOWN: f64 = 0.1;
+
+/// An estimate of a step's wall time.
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Estimate {
+    /// Seconds.
+    pub seconds: f64,
+    /// How far it may be off, relative (0.3: ±30 %).
+    pub within: f64,
+}
+
+/// Where an estimator's rates come from.
+#[derive(Copy, Clone, Debug, PartialEq)]
+pub enum Rates {
+    /// Measured on this device by the calibration kernel, in `seconds`.
+    Measured {
+        /// How long the calibration ran.
+        seconds: f64,
+    },
+    /// The built-in rates of 2 CPU cores or lavapipe: nothing measured here.
+    BuiltIn,
+}
+
+/// Estimates the steps of bakes on one device, and learns from each step timed.
+#[derive(Clone, Debug)]
+pub struct Estimator {
+    machine: Machine,
+    /// The share of its processors this process gets (1 on a quiet machine, and for a
+    /// hardware GPU, whose work is not the processors').
+    availability: f64,
+    shares: [f64; 7],
+    /// Σ ln(measured/estimated) over the steps timed, and their count.
+    log_ratio: f64,
+    timed: f64,
+    /// The largest |measured/estimated − 1| so far.
+    worst: f64,
+    /// Where the rates come from.
+    pub rates: Rates,
+}
+
+impl Estimator {
+    /// An estimator from `machine`'s measured rates, for a GPU (`gpu`) or the CPU.
+    pub fn new(machine: Machine, gpu: bool, rates: Rates) -> Self {
+        Self { machine, availability: 1.0, shares: if gpu { SHARES_GPU } else { SHARES_CPU }, log_ratio: 0.0, timed: 0.0, worst: 0.0, rates }
+    }
+
+    /// The estimator with the share of its processors this process gets (see
+    /// [`availability`]): every estimate is divided by it.
+    pub fn with_availability(self, availability: f64) -> Self {
+        Self { availability: availability.clamp(0.02, 1.0), ..self }
+    }
+
+    /// An estimator from the built-in rates of lavapipe (`gpu`) or 2 CPU cores, measured
+    /// quiet on the machines of this project: a library bake that shows no progress uses
+    /// these, and measures nothing.
+    pub fn built_in(gpu: bool) -> Self {
+        Self::new(if gpu { BUILT_IN_LAVAPIPE } else { BUILT_IN_CPU }, gpu, Rates::BuiltIn)
+    }
+
+    /// The correction `c` of the model (see the module's header).
+    fn correction(&self) -> f64 {
+        (self.log_ratio / (self.timed + 1.0)).exp()
+    }
+
+    /// The estimate of each step of `job`, in the order of [`Step::ALL`].
+    pub fn steps(&self, job: &Job) -> [(Step, Estimate); 7] {
+        let c = self.correction();
+        let base = if self.availability < LOADED { LOADED_SPREAD } else { MODEL_SPREAD };
+        let within = if self.rates == Rates::BuiltIn { f64::INFINITY } else { base.max(self.worst) };
+        let work = step_work(job);
+        let mut out = Step::ALL.map(|s| (s, Estimate { seconds: 0.0, within }));
+        for (k, (step, w)) in work.iter().enumerate() {
+            let (limit, _) = self.machine.limit(w);
+            out[k] = (*step, Estimate { seconds: limit / self.shares[k] / self.availability * c, within });
+        }
+        out
+    }
+
+    /// The estimate of step `step` of `job`.
+    pub fn step(&self, job: &Job, step: Step) -> Estimate {
+        self.steps(job).into_iter().find(|(s, _)| *s == step).expect("every step").1
+    }
+
+    /// The total of `job`'s steps, in seconds.
+    pub fn total(&self, job: &Job) -> f64 {
+        self.steps(job).iter().map(|(_, e)| e.seconds).sum()
+    }
+
+    /// Learns from a step estimated at `estimated` seconds that took `measured`.
+    pub fn record(&mut self, estimated: f64, measured: f64) {
+        if estimated < SHORTEST || measured < SHORTEST || !(estimated.is_finite() && measured.is_finite()) {
+            return;
+        }
+        self.worst = self.worst.max((measured / estimated - 1.0).abs());
+        self.log_ratio += (measured / estimated).ln();
+        self.timed += 1.0;
+    }
+}
+
+/// The limits of 2 CPU cores of the development machines, quiet (`runner bench`'s
+/// calibration line, December 2026).
+const BUILT_IN_CPU: Machine = Machine { filtered_reads: 0.5e9, summed_reads: 2.0e9, flops: 10.0e9 };
+
+/// The limits of lavapipe on 2 cores of the development machines, quiet.
+const BUILT_IN_LAVAPIPE: Machine = Machine { filtered_reads: 0.5e9, summed_reads: 2.0e9, flops: 10.0e9 };
+
+/// The estimators of this process, by backend identity: measured once, then taught by every
+/// step timed on that backend.
+static KEPT: std::sync::Mutex<Vec<(String, Estimator)>> = std::sync::Mutex::new(Vec::new());
+
+/// The estimator of `backend`'s steps. Where progress is shown (the command line), this
+/// device's rates, measured by a short calibration run the first time in the process (a
+/// step of its own in the progress) and kept, with what the steps since taught it; in a
+/// library that shows no progress, the built-in rates (nothing is measured, no time spent).
+///
+/// Where the work runs on this machine's processors (the CPU backend, a software GPU such
+/// as lavapipe), the calibration is timed by the processor time the process gets, which
+/// is what the device does unloaded, and the share of the processors the process gets now
+/// is measured apart ([`availability`]): on a loaded machine a few milliseconds of wall
+/// time are either a lucky run that nothing preempted or one that waited, while processor
+/// time over threads that spin for 40 ms averages the scheduler's share. A hardware GPU
+/// is timed by the wall clock.
+pub fn for_backend(backend: &crate::Backend) -> crate::error::Result<Estimator> {
+    if !crate::progress::shown() {
+        return Ok(Estimator::built_in(backend.is_gpu()));
+    }
+    let id = backend.identity();
+    if let Some((_, e)) = KEPT.lock().unwrap_or_else(|e| e.into_inner()).iter().find(|(k, _)| *k == id) {
+        return Ok(e.clone());
+    }
+    let _step = crate::progress::step("calibrating (this device's rates now, for the estimates)", None);
+    let start = web_time::Instant::now();
+    let threads = processor_threads(backend);
+    let clock = match threads {
+        Some(threads) if crate::cost::process_cpu_seconds().is_some() => crate::cost::Clock::Cpu { threads },
+        _ => crate::cost::Clock::Wall,
+    };
+    let how = crate::cost::Calibrating { run_seconds: if backend.is_gpu() { 0.02 } else { 0.005 }, runs: 3, clock };
+    let machine = crate::cost::measure_machine(backend, how)?;
+    let share = match (clock, threads) {
+        (crate::cost::Clock::Cpu { .. }, Some(t)) => availability(t),
+        _ => 1.0,
+    };
+    let e = Estimator::new(machine, backend.is_gpu(), Rates::Measured { seconds: start.elapsed().as_secs_f64() }).with_availability(share);
+    keep(backend, e.clone());
+    Ok(e)
+}
+
+/// The threads of this process that run `backend`'s work: rayon's for the CPU backend, a
+/// software GPU's (lavapipe and llvmpipe run one per processor, or `LP_NUM_THREADS`);
+/// `None` for a hardware GPU.
+fn processor_threads(backend: &crate::Backend) -> Option<u32> {
+    match backend {
+        crate::Backend::Cpu => Some(rayon::current_num_threads() as u32),
+        crate::Backend::Gpu(g) if g.is_software() => Some(
+            std::env::var("LP_NUM_THREADS")
+                .ok()
+                .and_then(|v| v.parse().ok())
+                .filter(|&n: &u32| n > 0)
+                .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get() as u32)),
+        ),
+        crate::Backend::Gpu(_) => None,
+    }
+}
+
+/// The share of `threads` processors this process gets now, from 0 to 1: `threads`
+/// threads spin for 40 ms of wall time, each counting the processor time it got (1 on a
+/// quiet machine; 1/3 for two threads beside four busy processes on two cores).
+pub fn availability(threads: u32) -> f64 {
+    #[cfg(all(unix, not(target_arch = "wasm32")))]
+    {
+        fn thread_seconds() -> f64 {
+            let mut t = libc::timespec { tv_sec: 0, tv_nsec: 0 };
+            // SAFETY: clock_gettime writes the timespec it is given; the clock is valid.
+            unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut t) };
+            t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
+        }
+        const WINDOW: std::time::Duration = std::time::Duration::from_millis(40);
+        let got: f64 = std::thread::scope(|s| {
+            let spinners: Vec<_> = (0..threads.max(1))
+                .map(|_| {
+                    s.spawn(|| {
+                        let (start, cpu) = (std::time::Instant::now(), thread_seconds());
+                        while start.elapsed() < WINDOW {
+                            std::hint::spin_loop();
+                        }
+                        (thread_seconds() - cpu) / start.elapsed().as_secs_f64()
+                    })
+                })
+                .collect();
+            spinners.into_iter().map(|h| h.join().unwrap_or(1.0)).sum()
+        });
+        (got / threads.max(1) as f64).clamp(0.02, 1.0)
+    }
+    #[cfg(not(all(unix, not(target_arch = "wasm32"))))]
+    {
+        let _ = threads;
+        1.0
+    }
+}
+
+/// Keeps `est` as `backend`'s estimator for the rest of the process.
+pub fn keep(backend: &crate::Backend, est: Estimator) {
+    if !crate::progress::shown() {
+        return;
+    }
+    let id = backend.identity();
+    let mut kept = KEPT.lock().unwrap_or_else(|e| e.into_inner());
+    match kept.iter_mut().find(|(k, _)| *k == id) {
+        Some((_, e)) => *e = est,
+        None => kept.push((id, est)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The correction is the geometric mean of measured/estimated with one exact step as
+    /// its prior: after one step off by a factor r, the next estimates move by √r; steps
+    /// under [`SHORTEST`] teach nothing; the stated spread is the worst step seen.
+    #[test]
+    fn the_correction_is_the_shrunk_geometric_mean_of_the_steps_seen() {
+        let machine = Machine { filtered_reads: 1e9, summed_reads: 1e9, flops: 1e10 };
+        let job = crate::Settings::default().resolve(crate::InputShape::Equirect { width: 1024, height: 512 }, crate::Products::STANDARD).unwrap();
+        let mut e = Estimator::new(machine, false, Rates::Measured { seconds: 0.0 });
+        let before = e.step(&job, Step::Specular);
+        assert_eq!(before.within, MODEL_SPREAD);
+        e.record(0.04, 1.0);
+        assert_eq!(e.step(&job, Step::Specular), before, "a step under 50 ms teaches nothing");
+        e.record(1.0, 4.0);
+        let after = e.step(&job, Step::Specular);
+        assert!((after.seconds / before.seconds - 2.0).abs() < 1e-12, "{} / {}", after.seconds, before.seconds);
+        assert!((after.within - 3.0).abs() < 1e-12);
+        assert!(Estimator::built_in(true).step(&job, Step::Specular).within.is_infinite(), "built-in rates claim no bound");
+    }
+}
