@@ -157,12 +157,14 @@ impl Estimator {
     }
 }
 
-/// The limits of 2 CPU cores of the development machines, quiet (`runner bench`'s
-/// calibration line, December 2026).
-const BUILT_IN_CPU: Machine = Machine { filtered_reads: 0.5e9, summed_reads: 2.0e9, flops: 10.0e9 };
+/// The limits of 2 CPU cores of the development machines, unloaded (the estimator's
+/// calibration, by processor time, six runs on a quiet machine, December 2026: 0.15–0.20 G
+/// filtered reads/s, 1.48–1.66 G summed reads/s, 24–26 GFLOP/s; medians, rounded).
+const BUILT_IN_CPU: Machine = Machine { filtered_reads: 0.17e9, summed_reads: 1.5e9, flops: 24e9 };
 
-/// The limits of lavapipe on 2 cores of the development machines, quiet.
-const BUILT_IN_LAVAPIPE: Machine = Machine { filtered_reads: 0.5e9, summed_reads: 2.0e9, flops: 10.0e9 };
+/// The limits of lavapipe on 2 cores of the development machines, likewise (0.13–0.20 G,
+/// 0.25–0.31 G, 9.6–11.8 GFLOP/s).
+const BUILT_IN_LAVAPIPE: Machine = Machine { filtered_reads: 0.155e9, summed_reads: 0.30e9, flops: 11e9 };
 
 /// The estimators of this process, by backend identity: measured once, then taught by every
 /// step timed on that backend.
