@@ -381,13 +381,12 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
 pub const BUDGETS: [f64; 6] = [0.1, 0.2, 0.3, 0.5, 1.0, 2.0];
 
 /// The budget-to-error curve on `backend`: for each budget, the settings
-/// `splitsum::cost::for_budget` chooses from `base` (by this backend's estimator: its limits
-/// measured by the calibration kernel first), baked, timed and measured at `points` with `base`'s
+/// `splitsum::cost::for_budget` chooses from `base` (by this backend's estimator, as
+/// `runner bake --budget` chooses: `splitsum::estimate::for_backend`), baked, timed and measured at `points` with `base`'s
 /// shading, as [`measure`] does; the rows carry the budget and the estimate. Budgets that
 /// choose the same settings share one bake.
 pub fn budget_rows(backend: &Backend, env: &Environment, base: &Method, points: &Points) -> Result<Vec<Measurement>> {
-    let machine = splitsum::cost::measure_machine(backend, splitsum::cost::Calibrating::THOROUGH)?;
-    let estimator = splitsum::estimate::Estimator::new(machine, backend.is_gpu(), splitsum::estimate::Rates::Measured { seconds: 0.0 });
+    let estimator = splitsum::estimate::for_backend(backend)?;
     let shape = splitsum::InputShape::of(env);
     let calibration = splitsum::cost::Calibration::default();
     let mut rows = Vec::new();
