@@ -207,9 +207,9 @@ pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products:
 }
 
 /// Bakes `job` (resolved for `env`) on `backend`, into host memory; its steps estimated by
-/// `backend`'s estimator (`crate::estimate::for_backend`), which learns from them.
+/// `backend`'s estimator (`crate::estimate::for_job`), which learns from them.
 pub fn bake_job(backend: &Backend, env: &Environment, job: &Job) -> Result<Baked> {
-    let mut est = crate::estimate::for_backend(backend)?;
+    let mut est = crate::estimate::for_job(backend, job)?;
     let baked = with_kernels!(backend, k => read(k, make(k, &mut est, env, job)?, job));
     crate::estimate::keep(backend, est);
     baked

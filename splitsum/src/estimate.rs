@@ -261,9 +261,21 @@ pub fn availability(threads: u32) -> f64 {
     }
 }
 
+/// The estimator for `job` on `backend`: [`for_backend`]'s, but without a calibration
+/// where `job` is estimated, at the built-in rates, under half of [`SHOWN`] in all (a
+/// tiny bake, whose steps would show no estimate: measuring the device would take longer
+/// than the bake).
+pub fn for_job(backend: &crate::Backend, job: &Job) -> crate::error::Result<Estimator> {
+    let kept = KEPT.lock().unwrap_or_else(|e| e.into_inner()).iter().any(|(k, _)| *k == backend.identity());
+    if !kept && Estimator::built_in(backend.is_gpu()).total(job) < 0.5 * SHOWN {
+        return Ok(Estimator::built_in(backend.is_gpu()));
+    }
+    for_backend(backend)
+}
+
 /// Keeps `est` as `backend`'s estimator for the rest of the process.
 pub fn keep(backend: &crate::Backend, est: Estimator) {
-    if !crate::progress::shown() {
+    if !crate::progress::shown() || est.rates == Rates::BuiltIn {
         return;
     }
     let id = backend.identity();
