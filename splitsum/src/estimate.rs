@@ -6,8 +6,7 @@
 //! summed texel reads, floating-point operations) and the calibration kernel measures what
 //! the device does per second of each kind *now*, under whatever load the machine carries
 //! (`cost::measure_machine`, about 0.1 s before the first bake of a process on 2 CPU
-//! cores, 0.3 s on lavapipe).
-//! The least time a step can take is its slowest kind of work at those rates (its limit);
+//! cores, 0.3 s on lavapipe; none for a bake too small to show an estimate). The least time a step can take is its slowest kind of work at those rates (its limit);
 //! a step reaches a share of that limit that depends on its code more than on the device
 //! or the load, so
 //!
@@ -21,8 +20,9 @@
 //! the geometric mean of measured/estimated over the steps already done in this process,
 //! shrunk towards 1 as if one more step had been exactly right: a load that changes after
 //! the calibration moves the later estimates with it. How sure: before any step has been
-//! timed, the model's own spread over the configurations the shares were measured on
-//! ([`MODEL_SPREAD`]); after, the larger of that and how far the steps done were off.
+//! timed, the 90th percentile of the model's error measured quiet ([`MODEL_SPREAD`]) or
+//! under load ([`LOADED_SPREAD`]); after, the larger of that and how far the steps done
+//! were off.
 
 use crate::cost::{Machine, step_work};
 use crate::settings::{Job, Step};
