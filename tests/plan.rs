@@ -520,14 +520,15 @@ fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The time-budget planner (`splitsum::cost::for_budget`) on a fixed machine: a larger
+/// The time-budget planner (`splitsum::estimate::for_budget`) on a fixed machine: a larger
 /// budget never predicts a larger error, every choice whose estimate fits is within its
 /// budget, and a budget below every candidate gets the cheapest (stated as over). The
 /// machine's rates are the calibration kernel's on lavapipe here (rounded), fixed so the
 /// test does not time anything.
 #[test]
 fn a_larger_budget_never_predicts_more_error() {
-    use splitsum::cost::{Machine, for_budget};
+    use splitsum::cost::Machine;
+    use splitsum::estimate::for_budget;
     use splitsum::estimate::{Estimator, Rates};
     let machine = Machine { filtered_reads: 0.25e9, summed_reads: 0.75e9, flops: 18e9 };
     let estimator = Estimator::new(machine, true, Rates::Measured { seconds: 0.0 });

@@ -23,7 +23,8 @@
 
 use crate::scene::{MaterialSpec, Scene};
 use serde::Serialize;
-use splitsum::cost::{Calibration, Cost, estimate};
+use splitsum::cost::{Calibration, Cost};
+use splitsum::estimate::built_in_cost as estimate;
 use splitsum::error::Result;
 use splitsum::settings::{InputShape, Job, Products, Settings, TableMethod};
 use splitsum_shaders::shade::SpecularModel;
@@ -224,7 +225,7 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     // (estimated on lavapipe's built-in rates, for the levels the plan keeps).
     if let Some(budget) = q.max_seconds {
         let products = Products { specular, irradiance, sh9: false, lut, sheen };
-        let seconds = |job: &splitsum::Job| job.clone().with_levels(levels.clone()).map_or(f64::INFINITY, |j| splitsum::cost::step_seconds(&j, true).total());
+        let seconds = |job: &splitsum::Job| job.clone().with_levels(levels.clone()).map_or(f64::INFINITY, |j| splitsum::estimate::step_seconds(&j, true).total());
         let (chosen, error, estimate) = splitsum::cost::for_budget_by(&settings, shape, products, budget, cal, Some(&needed_r), seconds)?;
         let fits = if estimate <= budget { "fits" } else { "is the cheapest measured, over" };
         decide(

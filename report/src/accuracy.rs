@@ -381,7 +381,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
 pub const BUDGETS: [f64; 6] = [0.1, 0.2, 0.3, 0.5, 1.0, 2.0];
 
 /// The budget-to-error curve on `backend`: for each budget, the settings
-/// `splitsum::cost::for_budget` chooses from `base` (by this backend's estimator, as
+/// `splitsum::estimate::for_budget` chooses from `base` (by this backend's estimator, as
 /// `runner bake --budget` chooses: `splitsum::estimate::for_backend`), baked, timed and measured at `points` with `base`'s
 /// shading, as [`measure`] does; the rows carry the budget and the estimate. Budgets that
 /// choose the same settings share one bake.
@@ -392,7 +392,7 @@ pub fn budget_rows(backend: &Backend, env: &Environment, base: &Method, points: 
     let mut rows = Vec::new();
     let mut done: Vec<(Settings, Vec<Measurement>)> = Vec::new();
     for budget in BUDGETS {
-        let (settings, _, estimate) = splitsum::cost::for_budget(&base.settings, shape, splitsum::Products::DISPLAY, budget, &estimator, &calibration)?;
+        let (settings, _, estimate) = splitsum::estimate::for_budget(&base.settings, shape, splitsum::Products::DISPLAY, budget, &estimator, &calibration)?;
         let measured = match done.iter().find(|(s, _)| *s == settings) {
             Some((_, r)) => r.clone(),
             None => {

@@ -739,7 +739,7 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
 }
 
 /// What the shading ladder is, in the report.
-const BUDGET_NOTE: &str = "For each time budget per bake, the settings splitsum::cost::for_budget chooses on this backend (by this backend's estimator, as runner bake --budget chooses: its rates measured now, the built-in error model): the sample count at mip 1 and the irradiance source. Each is baked, timed (the bake as run here, not the estimate) and measured end to end like the methods below: shaded colour against the full reflectance integral over this environment's points.";
+const BUDGET_NOTE: &str = "For each time budget per bake, the settings splitsum::estimate::for_budget chooses on this backend (by this backend's estimator, as runner bake --budget chooses: its rates measured now, the built-in error model): the sample count at mip 1 and the irradiance source. Each is baked, timed (the bake as run here, not the estimate) and measured end to end like the methods below: shaded colour against the full reflectance integral over this environment's points.";
 
 const LADDER_NOTE: &str = "The shading ladder: the split sum's one prefiltered fetch, then 2 to 16 fetches of filtered importance sampling of the true GGX lobe over the prefiltered mips (shade::lobe_radiance), used below n·v 0.7. Shaded colour against the full reflectance integral (mean relative luminance error, the largest point in brackets), against what a shaded pixel costs: ns per pixel of a sphere in the default view, direct lights included (a frame with the spheres less one without, best of three).";
 

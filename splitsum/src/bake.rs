@@ -74,7 +74,7 @@ fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, step: Step, job: &Job,
 /// Estimated seconds of each step of `job` at the built-in rates of lavapipe (`gpu`) or
 /// 2 CPU cores: what the hour limit ([`check_duration`]) refuses by, the same everywhere.
 pub fn step_estimates(gpu: bool, job: &Job) -> cost::Seconds {
-    cost::step_seconds(job, gpu)
+    crate::estimate::step_seconds(job, gpu)
 }
 
 /// Runs estimated over this many seconds are refused unless forced.

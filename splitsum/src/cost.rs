@@ -1,7 +1,7 @@
 //! What a bake costs before it runs: the error model a plan chooses from ([`Calibration`]),
-//! each step's work by kind ([`step_work`]) and a device's limits on each kind
-//! ([`measure_machine`]), which `crate::estimate` turns into seconds, and the time and
-//! memory of a resolved bake at the built-in rates ([`estimate`], [`step_seconds`]).
+//! each step's work by kind ([`step_work`]), a device's limits on each kind
+//! ([`measure_machine`]) and the bytes a bake holds, which `crate::estimate` turns into
+//! seconds and memory; the one search for a time budget ([`for_budget_by`]).
 
 use crate::measured::{Knob, Measurement, Method, Part, Product};
 use crate::settings::{InputShape, Job, Step, TableMethod};
@@ -164,7 +164,7 @@ impl PerStep {
 
 /// The bytes of `job`'s products in memory (each prefiltered level with its sums, the
 /// tables, the irradiance with its sums) and of its source cube.
-fn product_bytes(job: &Job) -> u64 {
+pub fn product_bytes(job: &Job) -> u64 {
     let mut bytes = job.source_layout().texel_count() as u64 * 16;
     for cube in prefiltered_cubes(job) {
         for &l in cube.levels {
@@ -182,28 +182,6 @@ fn product_bytes(job: &Job) -> u64 {
         bytes += 6 * (job.irradiance_size as u64).pow(2) * 64;
     }
     bytes
-}
-
-/// Estimated seconds of each step of `job` at the built-in rates of lavapipe (`gpu`) or
-/// 2 CPU cores, measured quiet (`crate::estimate::Estimator::built_in`): what the planner
-/// compares and the hour limit refuses, the same on every machine.
-pub fn step_seconds(job: &Job, gpu: bool) -> Seconds {
-    let mut out = PerStep::default();
-    for (step, e) in crate::estimate::Estimator::built_in(gpu).steps(job) {
-        out[step] = e.seconds;
-    }
-    out
-}
-
-/// Estimated time (at the built-in rates, [`step_seconds`]) and memory of `job`: the
-/// products and their sums, plus the environment as read (RGBA f32, with its row pyramid:
-/// `12·width²` bytes).
-pub fn estimate(job: &Job) -> Cost {
-    let width = match job.input {
-        InputShape::Equirect { width, .. } => width as u64,
-        _ => 0,
-    };
-    Cost { gpu_seconds: step_seconds(job, true).total(), cpu_seconds: step_seconds(job, false).total(), bytes: product_bytes(job) + 12 * width.pow(2) }
 }
 
 /// The work of one step, by kind: what the cost model of `runner bench` counts.
@@ -466,13 +444,6 @@ pub fn measure_machine(backend: &crate::backend::Backend, how: Calibrating) -> c
         Backend::Gpu(g) => measure(&|r| rate(&**g, r, how)),
         Backend::Cpu => measure(&|r| rate(&crate::backend::Cpu, r, how)),
     }
-}
-
-/// The settings a bake within `budget` seconds should use, with their estimated seconds
-/// by `estimator` (this device's measured rates): [`for_budget_by`] over every calibrated
-/// roughness band.
-pub fn for_budget(given: &crate::settings::Settings, shape: InputShape, products: crate::settings::Products, budget: f64, estimator: &crate::estimate::Estimator, cal: &Calibration) -> crate::error::Result<(crate::settings::Settings, f64, f64)> {
-    for_budget_by(given, shape, products, budget, cal, None, |job| estimator.total(job))
 }
 
 /// The one search for a time budget: among the specular sample counts and irradiance

@@ -27,6 +27,11 @@
 use crate::cost::{Machine, step_work};
 use crate::settings::{Job, Step};
 
+// What progress shows of an estimate, and from how long a step on: progress's own (it
+// depends on nothing here; the cost model this module reads depends on the backends,
+// which speak through progress).
+pub use crate::progress::{Estimate, SHOWN};
+
 /// The share of its limit each step reaches, in the order of [`Step::ALL`], on 2 CPU cores:
 /// the median of limit/time over five quiet `runner bench --runs 1` of city.exr, with and
 /// without `--sheen` (the tuning set; each a process of its own, calibrated as a bake is,
@@ -55,19 +60,6 @@ pub const LOADED: f64 = 0.8;
 /// Steps shorter than this (seconds) teach the estimator nothing: their time is mostly
 /// fixed costs (a dispatch, an upload, a scheduler's slice) the limits do not model.
 pub const SHORTEST: f64 = 0.05;
-
-/// Steps estimated under this (seconds) show no estimate: under load such a step either
-/// runs within one slice of the scheduler or waits for the next, and is off by up to 3×.
-pub const SHOWN: f64 = 0.1;
-
-/// An estimate of a step's wall time.
-#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Estimate {
-    /// Seconds.
-    pub seconds: f64,
-    /// How far it may be off, relative (0.3: ±30 %).
-    pub within: f64,
-}
 
 /// Where an estimator's rates come from.
 #[derive(Copy, Clone, Debug, PartialEq)]
@@ -155,6 +147,35 @@ impl Estimator {
         self.log_ratio += (measured / estimated).ln();
         self.timed += 1.0;
     }
+}
+
+/// Estimated seconds of each step of `job` at the built-in rates of lavapipe (`gpu`) or
+/// 2 CPU cores, measured quiet ([`Estimator::built_in`]): what the planner
+/// compares and the hour limit refuses, the same on every machine.
+pub fn step_seconds(job: &Job, gpu: bool) -> crate::cost::Seconds {
+    let mut out = crate::cost::PerStep::default();
+    for (step, e) in Estimator::built_in(gpu).steps(job) {
+        out[step] = e.seconds;
+    }
+    out
+}
+
+/// Estimated time (at the built-in rates, [`step_seconds`]) and memory of `job`: the
+/// products and their sums, plus the environment as read (RGBA f32, with its row pyramid:
+/// `12·width²` bytes).
+pub fn built_in_cost(job: &Job) -> crate::cost::Cost {
+    let width = match job.input {
+        crate::settings::InputShape::Equirect { width, .. } => width as u64,
+        _ => 0,
+    };
+    crate::cost::Cost { gpu_seconds: step_seconds(job, true).total(), cpu_seconds: step_seconds(job, false).total(), bytes: crate::cost::product_bytes(job) + 12 * width.pow(2) }
+}
+
+/// The settings a bake within `budget` seconds should use, with their estimated seconds
+/// by `estimator` (this device's measured rates): `cost::for_budget_by` over every calibrated
+/// roughness band.
+pub fn for_budget(given: &crate::settings::Settings, shape: crate::settings::InputShape, products: crate::settings::Products, budget: f64, estimator: &Estimator, cal: &crate::cost::Calibration) -> crate::error::Result<(crate::settings::Settings, f64, f64)> {
+    crate::cost::for_budget_by(given, shape, products, budget, cal, None, |job| estimator.total(job))
 }
 
 /// The limits of 2 CPU cores of the development machines, unloaded (the estimator's

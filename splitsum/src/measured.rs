@@ -76,7 +76,7 @@ pub enum Method {
     Sh9,
     /// The split sum from exact ingredients: the error of the approximation itself.
     ExactIngredients,
-    /// The settings `cost::for_budget` chooses for a time budget (`budget_s`) on the
+    /// The settings `estimate::for_budget` chooses for a time budget (`budget_s`) on the
     /// backend, and the default shading.
     TimeBudget,
 }

@@ -1,5 +1,5 @@
 //! Progress on stderr. Every step of a bake shows a spinner with its elapsed time and its
-//! estimate with how far it may be off (`crate::estimate`), and the CPU backend's long loops a bar under
+//! estimate with how far it may be off (made by `crate::estimate`), and the CPU backend's long loops a bar under
 //! it; all are drawn by one `indicatif::MultiProgress`. Where stderr is not a terminal
 //! (CI logs, pipes), bars are hidden and each step prints one line as it starts instead.
 //!
@@ -13,16 +13,16 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 static MULTI: LazyLock<MultiProgress> = LazyLock::new(MultiProgress::new);
-static SHOWN: AtomicBool = AtomicBool::new(false);
+static ON: AtomicBool = AtomicBool::new(false);
 
 /// Shows progress on stderr from now on (`false`: hides it again).
 pub fn show(on: bool) {
-    SHOWN.store(on, Ordering::Relaxed);
+    ON.store(on, Ordering::Relaxed);
 }
 
 /// Whether progress is shown (the command line turned it on).
 pub fn shown() -> bool {
-    SHOWN.load(Ordering::Relaxed)
+    ON.load(Ordering::Relaxed)
 }
 
 fn interactive() -> bool {
@@ -57,12 +57,25 @@ pub fn bar(what: &str, len: u64) -> ProgressBar {
 /// never touches one).
 pub struct Step(Option<ProgressBar>);
 
+/// An estimate of a step's wall time (`crate::estimate` makes them).
+#[derive(Copy, Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Estimate {
+    /// Seconds.
+    pub seconds: f64,
+    /// How far it may be off, relative (0.3: ±30 %; infinite where nothing was measured).
+    pub within: f64,
+}
+
+/// Steps estimated under this (seconds) show no estimate: under load such a step either
+/// runs within one slice of the scheduler or waits for the next, and is off by up to 3×.
+pub const SHOWN: f64 = 0.1;
+
 /// Starts step `what`, estimated to take `estimate` (if known): shown with how far it may
 /// be off where the estimate comes from this device's rates, alone where it does not.
-pub fn step(what: &str, estimate: Option<crate::estimate::Estimate>) -> Step {
+pub fn step(what: &str, estimate: Option<Estimate>) -> Step {
     let est = match estimate {
-        Some(e) if e.seconds >= crate::estimate::SHOWN && e.within.is_finite() => format!(" (estimate {} ±{:.0} %)", seconds(e.seconds), 100.0 * e.within),
-        Some(e) if e.seconds >= crate::estimate::SHOWN => format!(" (estimate {}, at built-in rates)", seconds(e.seconds)),
+        Some(e) if e.seconds >= SHOWN && e.within.is_finite() => format!(" (estimate {} ±{:.0} %)", seconds(e.seconds), 100.0 * e.within),
+        Some(e) if e.seconds >= SHOWN => format!(" (estimate {}, at built-in rates)", seconds(e.seconds)),
         _ => String::new(),
     };
     if !shown() {

@@ -130,7 +130,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
 }
 
 /// The settings for a bake within `budget` seconds of this run on `backend`
-/// (`splitsum::cost::for_budget`, by this device's estimator), stated; refuses `--budget`
+/// (`splitsum::estimate::for_budget`, by this device's estimator), stated; refuses `--budget`
 /// beside a flag it would choose. The budget counts what the run has spent since `started`
 /// (starting the device, reading the input, the calibration of the estimator): the bake
 /// gets what is left. Writing the files comes after and is not counted (it is said so).
@@ -154,7 +154,7 @@ fn within_budget(
     let estimator = splitsum::estimate::for_backend(backend)?;
     let spent = started.elapsed().as_secs_f64();
     let left = budget - spent;
-    let (chosen, error, seconds) = splitsum::cost::for_budget(settings, shape, products, left.max(0.0), &estimator, &splitsum::cost::Calibration::default())?;
+    let (chosen, error, seconds) = splitsum::estimate::for_budget(settings, shape, products, left.max(0.0), &estimator, &splitsum::cost::Calibration::default())?;
     let within = estimator.steps(&chosen.resolve(shape, products)?).iter().map(|(_, e)| e.within).fold(0.0, f64::max);
     let fits = if seconds <= left { "fits" } else { "is the cheapest, and still over" };
     println!(
