@@ -46,6 +46,26 @@ ensure_nightly() {
     fi
 }
 
+# What the committed SPIR-V is compiled from, and the module and linkage themselves, as one
+# hash (git's tracked files, read from the working tree; empty outside a git checkout).
+SPIRV_STAMP=spirv/src/compiled_from.sha256
+spirv_hash() {
+    git rev-parse --is-inside-work-tree >/dev/null 2>&1 || return 0
+    {
+        echo "$NIGHTLY"
+        git ls-files -z -- shaders/src shaders/Cargo.toml xtask Cargo.toml Cargo.lock spirv/src/splitsum_shaders.spv spirv/src/linkage.rs \
+            | sort -z | xargs -0 sha256sum
+    } | sha256sum | cut -d' ' -f1
+}
+spirv_stamped() { [ -f "$SPIRV_STAMP" ] && grep -v '^#' "$SPIRV_STAMP" | head -n1 || true; }
+spirv_stamp() {
+    local h
+    h=$(spirv_hash)
+    [ -n "$h" ] || return 0
+    { echo '# Written by scripts/dev.sh (spirv) after compiling shaders/: see spirv_hash there.'; echo "$h"; } >"$SPIRV_STAMP"
+    echo "dev.sh: wrote $SPIRV_STAMP" >&2
+}
+
 as_root() {
     if [ "$(id -u)" = 0 ]; then "$@"; elif command -v sudo >/dev/null; then sudo "$@"; else
         echo "dev.sh: need root to run: $*" >&2; return 1
@@ -228,8 +248,19 @@ case "$cmd" in
         run_last cargo +stable run --release -q -p splitsum --features internals --example embedded_table -- "$f" "$g"
         ;;
     spirv)
+        # After a regeneration (or a full check) the stamp records the hash of what the
+        # module is compiled from and of the module itself; `--check` skips the compile
+        # (about 12 minutes on a fresh machine) only while that hash still matches, so a
+        # change to shaders/, xtask/, the workspace's manifest or lock, the nightly, or the
+        # committed module and linkage always compiles and compares. SPLITSUM_SPIRV_FULL=1
+        # compiles and compares regardless.
+        if ! dry && [ "${1:-}" = --check ] && [ -z "${SPLITSUM_SPIRV_FULL:-}" ] && [ "$(spirv_hash)" = "$(spirv_stamped)" ] && [ -n "$(spirv_stamped)" ]; then
+            echo "dev.sh: the committed SPIR-V and linkage were compiled from these sources ($SPIRV_STAMP matches); not recompiled (SPLITSUM_SPIRV_FULL=1 compiles and compares anyway)" >&2
+            exit 0
+        fi
         ensure_nightly
-        run_last cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
+        run cargo +"$NIGHTLY" run --release --manifest-path xtask/Cargo.toml -- spirv "$@"
+        dry || spirv_stamp
         ;;
     *)
         echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | table | peers | environments | viewer" >&2
