@@ -254,7 +254,8 @@ case "$cmd" in
         # change to shaders/, xtask/, the workspace's manifest or lock, the nightly, or the
         # committed module and linkage always compiles and compares. SPLITSUM_SPIRV_FULL=1
         # compiles and compares regardless.
-        if ! dry && [ "${1:-}" = --check ] && [ -z "${SPLITSUM_SPIRV_FULL:-}" ] && [ "$(spirv_hash)" = "$(spirv_stamped)" ] && [ -n "$(spirv_stamped)" ]; then
+        stamped=$(spirv_stamped)
+        if ! dry && [ "${1:-}" = --check ] && [ -z "${SPLITSUM_SPIRV_FULL:-}" ] && [ -n "$stamped" ] && [ "$(spirv_hash)" = "$stamped" ]; then
             echo "dev.sh: the committed SPIR-V and linkage were compiled from these sources ($SPIRV_STAMP matches); not recompiled (SPLITSUM_SPIRV_FULL=1 compiles and compares anyway)" >&2
             exit 0
         fi

@@ -24,7 +24,7 @@
 use crate::scene::{MaterialSpec, Scene};
 use serde::Serialize;
 use splitsum::cost::{Calibration, Cost};
-use splitsum::estimate::built_in_cost as estimate;
+use splitsum::estimate::built_in_cost;
 use splitsum::error::Result;
 use splitsum::settings::{InputShape, Job, Products, Settings, TableMethod};
 use splitsum_shaders::shade::SpecularModel;
@@ -270,9 +270,9 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
 
     let products = Products { specular, irradiance, sh9: false, lut, sheen };
     let job = settings.resolve(shape, products)?.with_levels(levels)?.with_sheen_levels(sheen_levels)?;
-    let cost = estimate(&job);
-    let full_cost = estimate(&settings.resolve(shape, Products::DISPLAY)?);
-    let default_cost = estimate(&Settings::default().resolve(shape, Products::STANDARD)?);
+    let cost = built_in_cost(&job);
+    let full_cost = built_in_cost(&settings.resolve(shape, Products::DISPLAY)?);
+    let default_cost = built_in_cost(&Settings::default().resolve(shape, Products::STANDARD)?);
     Ok(Plan { job, decisions: d, cost, full_cost, default_cost })
 }
 

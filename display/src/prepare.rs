@@ -3,7 +3,7 @@
 //! build is there.
 
 use splitsum::Backend;
-use splitsum::bake::{BakedEnvironment, Timing, bake_job, check_duration, step_estimates};
+use splitsum::bake::{BakedEnvironment, Timing, bake_job, check_duration};
 use splitsum::error::Result;
 
 /// What happened to a scene's bake.
@@ -69,7 +69,7 @@ pub fn bake_scene(
             splitsum::cache::Lookup::Foreign(e) => return Err(e),
         }
     }
-    check_duration(&step_estimates(backend.is_gpu(), &plan.job), force)?;
+    check_duration(&splitsum::estimate::step_seconds(&plan.job, backend.is_gpu()), force)?;
     let (baked, timings) = bake_plan(backend, &env, &plan)?;
     if let Some(c) = cache {
         c.put(&key, &baked)?;

@@ -71,16 +71,11 @@ fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, step: Step, job: &Job,
     Ok(r)
 }
 
-/// Estimated seconds of each step of `job` at the built-in rates of lavapipe (`gpu`) or
-/// 2 CPU cores: what the hour limit ([`check_duration`]) refuses by, the same everywhere.
-pub fn step_estimates(gpu: bool, job: &Job) -> cost::Seconds {
-    crate::estimate::step_seconds(job, gpu)
-}
-
 /// Runs estimated over this many seconds are refused unless forced.
 pub const MAX_UNFORCED_SECONDS: f64 = 3600.0;
 
-/// Refuses a run estimated (`estimates`, seconds per step) to take over an hour, unless
+/// Refuses a run estimated (`estimates`, seconds per step at the built-in rates:
+/// `crate::estimate::step_seconds`, the same everywhere) to take over an hour, unless
 /// `force` (`Error::TooLong`, naming the estimate and its longest step).
 pub fn check_duration(estimates: &cost::Seconds, force: bool) -> Result<()> {
     let total = estimates.total();

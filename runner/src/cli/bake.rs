@@ -98,7 +98,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
         settings = within_budget(&settings, InputShape::of(&env), products, budget, &backend, given, started)?;
     }
     let job = settings.resolve(InputShape::of(&env), products)?;
-    bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.scene.force)?;
+    bake::check_duration(&splitsum::estimate::step_seconds(&job, backend.is_gpu()), args.scene.force)?;
     println!("baking {} on {} for {}", env_path.display(), backend.describe(), job.target.name());
     for a in job.adjustments() {
         eprintln!("note: {}", a.describe(&flag_of));

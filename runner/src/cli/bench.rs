@@ -58,7 +58,7 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
                 continue;
             }
         };
-        bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), args.force)?;
+        bake::check_duration(&splitsum::estimate::step_seconds(&job, backend.is_gpu()), args.force)?;
         // The fastest run of each step, with the estimate shown as that run's step started
         // (the estimator learns from every run: later runs are estimated by what the
         // earlier ones took, as in a batch).

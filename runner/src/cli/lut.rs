@@ -63,7 +63,7 @@ pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
     let start = Instant::now();
     // A table alone needs no source cube: its own step's estimate is the run's.
     let mut table = crate::cost::PerStep::default();
-    table[Step::BrdfTable] = crate::bake::step_estimates(backend.is_gpu(), &job)[Step::BrdfTable];
+    table[Step::BrdfTable] = splitsum::estimate::step_seconds(&job, backend.is_gpu())[Step::BrdfTable];
     crate::bake::check_duration(&table, args.force).map_err(in_flags)?;
     let lut = match job.lut_method {
         TableMethod::Quadrature => backend.brdf_table(job.lut_size, job.lut_masking),

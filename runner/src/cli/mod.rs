@@ -214,7 +214,7 @@ impl DisplayBakeArgs {
         for a in job.adjustments() {
             eprintln!("note: {}", a.describe(&flag_of));
         }
-        bake::check_duration(&bake::step_estimates(backend.is_gpu(), &job), force)?;
+        bake::check_duration(&splitsum::estimate::step_seconds(&job, backend.is_gpu()), force)?;
         let start = Instant::now();
         let baked = bake::bake_job(backend, env, &job)?.into_display(job.mapping);
         Ok((baked, start.elapsed().as_secs_f64()))
