@@ -15,6 +15,7 @@ mod lut;
 mod model;
 mod plan;
 mod portability;
+mod public_api;
 mod prefilter;
 mod render;
 mod report;
