@@ -23,7 +23,7 @@ use std::path::PathBuf;
 /// same orientation, roughness per mip and table. With sheen they differ where the sheen
 /// cubes differ; the difference is reported, not bounded (at sheen roughness 0.5
 /// glTF-IBL-Sampler's Charlie cube is 14 % from the exact integral and splitsum's 1.8 %,
-/// `khronos_target_matches_gltf_ibl_sampler`).
+/// `targets::sampler::khronos_target_matches_gltf_ibl_sampler`).
 #[test]
 fn the_sample_viewer_renders_the_khronos_folder() {
     let here = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("viewer");
@@ -34,7 +34,7 @@ fn the_sample_viewer_renders_the_khronos_folder() {
     );
     let bin = peers();
     let d = scratch("viewer");
-    // The analytic sky of `khronos_target_matches_gltf_ibl_sampler`: a gradient and suns.
+    // The analytic sky of `targets::sampler::khronos_target_matches_gltf_ibl_sampler`: a gradient and suns.
     let suns = [([0.3, 0.5, -0.81], [40.0, 30.0, 20.0]), ([-0.8, 0.2, 0.56], [4.0, 8.0, 12.0]), ([0.2, -0.3, 0.93], [10.0, 6.0, 3.0])];
     // 256×128: the renderer filters it itself for one lighting of every frame, which on
     // SwiftShader takes most of the test's time.

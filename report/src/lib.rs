@@ -13,8 +13,10 @@
 
 pub mod accuracy;
 pub mod measurement;
+pub mod pages;
 pub mod plot;
 pub mod report;
 pub mod sets;
 pub mod skies;
 pub mod surface;
+pub mod sweep;

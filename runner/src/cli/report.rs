@@ -39,15 +39,15 @@ pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
         }
     }
     anyhow::ensure!(!backends.is_empty(), "no backend could be opened");
-    let sweep = if args.quick { crate::report::Sweep::quick() } else { crate::report::Sweep::full() };
+    let sweep = if args.quick { splitsum_report::sweep::Sweep::quick() } else { splitsum_report::sweep::Sweep::full() };
     let start = Instant::now();
     let out = files::OutputDir::begin(&args.out, "--out")?;
-    let sets = args.sets.then(|| crate::report::Sets { dir: args.environments.clone(), present_only: args.quick, only: args.set });
+    let sets = args.sets.then(|| splitsum_report::sweep::Sets { dir: args.environments.clone(), present_only: args.quick, only: args.set });
     let costs = ladder_costs(&env, &backends, args.quick)?;
     let rows = crate::report::run(&env, &name, &backends, &sweep, sets.as_ref(), &costs, out.path())?;
     out.commit()?;
     println!("{} measurements in {:.1} s", rows.len(), start.elapsed().as_secs_f64());
-    for (panel, r) in crate::report::best_per_ms(&rows) {
+    for (panel, r) in splitsum_report::pages::best_per_ms(&rows) {
         let ms = r.time_ms.unwrap_or(f64::NAN);
         println!("  best error per ms: {panel:<44} {:<4} {:<24} {ms:>9.1} ms  mean error {:.2e}", r.backend, r.setting(), r.mean_error);
     }
@@ -70,7 +70,7 @@ fn ladder_costs(env: &environment::Environment, backends: &[Backend], quick: boo
         let filtered = (Method::FilteredSampling, 1, ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::FILTERED_SAMPLING, ..ShadeOptions::DEFAULT });
         let rungs = (0..LADDER_RUNGS).map(|rung| {
             let fetches = 1 << rung;
-            (crate::report::rung_method(fetches), fetches, ShadeOptions::DEFAULT.with_fetches(fetches))
+            (splitsum_report::pages::rung_method(fetches), fetches, ShadeOptions::DEFAULT.with_fetches(fetches))
         });
         for (method, fetches, options) in rungs.chain([filtered]) {
             let ns = crate::render::shading_ns_per_pixel(backend, &baked, options, frame, repeats)?;
