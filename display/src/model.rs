@@ -144,7 +144,7 @@ pub fn load(path: &Path) -> Result<Model> {
 /// read from its JSON alone, no buffer or image decoded. For a scene's plan.
 pub fn uses_sheen(path: &Path) -> Result<bool> {
     let bytes = read_regular(path, None)?;
-    let doc = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| Error::file(path, format!("cannot load the glTF: {e}")))?;
+    let doc = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| Error::file_caused(path, "cannot load the glTF", e))?;
     Ok(doc.materials().any(|m| {
         m.extension_value(SHEEN).is_some_and(|e| {
             e.get("sheenColorTexture").is_some()
@@ -160,14 +160,14 @@ const DRACO: &str = "KHR_draco_mesh_compression";
 /// a pipe (which could be endless) is refused.
 fn read_regular(path: &Path, limit: Option<u64>) -> Result<Vec<u8>> {
     use std::io::Read;
-    let file = std::fs::File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let meta = file.metadata().map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let file = std::fs::File::open(path).map_err(|e| Error::file_caused(path, "cannot read", e))?;
+    let meta = file.metadata().map_err(|e| Error::file_caused(path, "cannot read", e))?;
     if !meta.is_file() {
         return Err(Error::file(path, "is not a regular file"));
     }
     let want = limit.unwrap_or(meta.len()).min(meta.len());
     let mut bytes = Vec::with_capacity(want as usize);
-    file.take(want).read_to_end(&mut bytes).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    file.take(want).read_to_end(&mut bytes).map_err(|e| Error::file_caused(path, "cannot read", e))?;
     Ok(bytes)
 }
 
@@ -176,7 +176,7 @@ fn read_regular(path: &Path, limit: Option<u64>) -> Result<Vec<u8>> {
 /// Every buffer is read from a data URI, the GLB's binary chunk or a regular file, no
 /// further than its `byteLength`; every image is decoded within [`MAX_TEXTURE`].
 fn import(path: &Path, bytes: &[u8], base: Option<&Path>) -> Result<(gltf::Document, Vec<gltf::buffer::Data>, Vec<gltf::image::Data>)> {
-    let fail = |e: gltf::Error| Error::file(path, format!("cannot load the glTF: {e}"));
+    let fail = |e: gltf::Error| Error::file_caused(path, "cannot load the glTF", e);
     if let [b'g', b'l', b'T', b'F', _, _, _, _, l0, l1, l2, l3, ..] = *bytes {
         let declared = u32::from_le_bytes([l0, l1, l2, l3]) as usize;
         if declared > bytes.len() {
@@ -248,7 +248,7 @@ fn import(path: &Path, bytes: &[u8], base: Option<&Path>) -> Result<(gltf::Docum
 fn read_uri(path: &Path, base: Option<&Path>, uri: &str, limit: Option<u64>) -> Result<Vec<u8>> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let payload = rest.split_once(";base64,").map_or(rest, |(_, b)| b);
-        return base64::decode(payload).map_err(|e| Error::file(path, format!("a data URI is not valid base64: {e}")));
+        return base64::decode(payload).map_err(|e| Error::file_caused(path, "a data URI is not valid base64", e));
     }
     let Some(base) = base else {
         return Err(Error::file(path, format!("names the file {uri:?}, but an embedded model may name none")));
@@ -258,7 +258,7 @@ fn read_uri(path: &Path, base: Option<&Path>, uri: &str, limit: Option<u64>) -> 
         return Err(Error::file(path, format!("names {uri:?}, which is neither a data URI nor a file")));
     }
     let decoded = percent_decode(relative);
-    read_regular(&base.join(decoded), limit).map_err(|e| Error::file(path, format!("{uri:?}: {e}")))
+    read_regular(&base.join(decoded), limit).map_err(|e| Error::file_caused(path, format!("{uri:?}"), e))
 }
 
 /// `%XX` escapes of a URI decoded (glTF 2.0 §3.3: URIs are RFC 3986).
@@ -301,7 +301,7 @@ fn decode_image(path: &Path, index: usize, encoded: &[u8], mime: Option<&str>) -
     reader.limits(limits);
     let img = reader.decode().map_err(|e| match e {
         image::ImageError::Limits(_) => Error::file(path, format!("image {index} is larger than the {MAX_TEXTURE}×{MAX_TEXTURE} texels a texture may have")),
-        e => Error::file(path, format!("image {index} cannot be decoded: {e}")),
+        e => Error::file_caused(path, format!("image {index} cannot be decoded"), e),
     })?;
     let (width, height) = (img.width(), img.height());
     Ok(gltf::image::Data { pixels: img.into_rgba8().into_raw(), format: gltf::image::Format::R8G8B8A8, width, height })

@@ -144,7 +144,16 @@ impl App {
             .and_then(|p| splitsum::files::write_png(&path, w, h, &crate::render::to_rgb8(&p)));
         match result {
             Ok(()) => println!("wrote {}", path.display()),
-            Err(e) => eprintln!("screenshot: {e}"),
+            Err(e) => {
+                // The message and what failed underneath it, as the command line prints errors.
+                let mut text = e.to_string();
+                let mut cause = std::error::Error::source(&e);
+                while let Some(c) = cause {
+                    text += &format!(": {c}");
+                    cause = c.source();
+                }
+                eprintln!("screenshot: {text}");
+            }
         }
     }
 
@@ -205,27 +214,27 @@ impl ApplicationHandler for App {
         let window = match event_loop.create_window(attributes) {
             Ok(w) => Arc::new(w),
             Err(e) => {
-                self.error = Some(Error::Gpu(format!("could not open a window: {e}")));
+                self.error = Some(Error::gpu_caused("could not open a window", e));
                 event_loop.exit();
                 return;
             }
         };
         let (Some(instance), Some(adapter)) = (&self.gpu.instance, &self.gpu.adapter) else {
-            self.error = Some(Error::Gpu("the viewer presents on a device it opened itself (Gpu::new), not a caller's".into()));
+            self.error = Some(Error::gpu("the viewer presents on a device it opened itself (Gpu::new), not a caller's"));
             event_loop.exit();
             return;
         };
         let surface = match instance.create_surface(window.clone()) {
             Ok(s) => s,
             Err(e) => {
-                self.error = Some(Error::Gpu(format!("could not create a surface for the window: {e}")));
+                self.error = Some(Error::gpu_caused("could not create a surface for the window", e));
                 event_loop.exit();
                 return;
             }
         };
         let caps = surface.get_capabilities(adapter);
         if caps.formats.is_empty() {
-            self.error = Some(Error::Gpu(format!("{} cannot present to this window", self.gpu.info.name)));
+            self.error = Some(Error::gpu(format!("{} cannot present to this window", self.gpu.info.name)));
             event_loop.exit();
             return;
         }
@@ -312,7 +321,7 @@ pub fn run(gpu: Gpu, env: &BakedEnvironment, model: Option<&Model>, state: ViewS
         EventLoopBuilderExtX11::with_any_thread(&mut builder, true);
         EventLoopBuilderExtWayland::with_any_thread(&mut builder, true);
     }
-    let event_loop = builder.build().map_err(|e| Error::Gpu(format!("no display to open a window on ({e}); use `runner render` instead")))?;
+    let event_loop = builder.build().map_err(|e| Error::gpu(format!("no display to open a window on ({e}); use `runner render` instead")))?;
     let scene = GpuScene::new(&gpu, env);
     let model = model.map(|m| GpuModel::new(&gpu, &scene, m));
     println!("{HELP}");
@@ -336,7 +345,7 @@ pub fn run(gpu: Gpu, env: &BakedEnvironment, model: Option<&Model>, state: ViewS
         done: false,
         error: None,
     };
-    event_loop.run_app(&mut app).map_err(|e| Error::Gpu(format!("window event loop: {e}")))?;
+    event_loop.run_app(&mut app).map_err(|e| Error::gpu_caused("window event loop", e))?;
     match app.error {
         Some(e) => Err(e),
         None => Ok(()),

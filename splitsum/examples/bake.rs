@@ -8,7 +8,8 @@
 //! `WGPU_BACKEND` (`vulkan`, `metal`, `dx12`, `gl`) and `WGPU_ADAPTER_NAME` choose the
 //! device, as in any wgpu application.
 
-use splitsum::{Baker, Compute, Ibl, Manifest, Settings, Source};
+use splitsum::output::Manifest;
+use splitsum::{Baker, Compute, Ibl, Settings, Source};
 use std::path::Path;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

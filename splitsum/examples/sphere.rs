@@ -10,7 +10,8 @@
 //! shading here is the application's own (split sum: `E/π·ρ + prefiltered(r)·(F₀A + B)`),
 //! written in WGSL as an engine would; splitsum provides what it samples.
 
-use splitsum::{Baker, Compute, Environment, Settings, Source};
+use splitsum::environment::Environment;
+use splitsum::{Baker, Compute, Settings, Source};
 
 /// The sphere's material.
 #[derive(Copy, Clone, Debug)]
@@ -180,9 +181,9 @@ pub fn draw(
     queue.submit([encoder.finish()]);
     let (tx, rx) = std::sync::mpsc::channel();
     readback.slice(..).map_async(wgpu::MapMode::Read, move |r| tx.send(r).expect("the receiver waits"));
-    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| splitsum::Error::Gpu(e.to_string()))?;
-    rx.recv().expect("mapped").map_err(|e| splitsum::Error::Gpu(e.to_string()))?;
-    let bytes = readback.slice(..).get_mapped_range().map_err(|e| splitsum::Error::Gpu(e.to_string()))?.to_vec();
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| splitsum::Error::gpu(e.to_string()))?;
+    rx.recv().expect("mapped").map_err(|e| splitsum::Error::gpu(e.to_string()))?;
+    let bytes = readback.slice(..).get_mapped_range().map_err(|e| splitsum::Error::gpu(e.to_string()))?.to_vec();
     let pixels = (0..size as usize)
         .flat_map(|y| {
             let line: &[[u16; 4]] = bytemuck::cast_slice(&bytes[y * row as usize..y * row as usize + size as usize * 8]);

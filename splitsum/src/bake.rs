@@ -307,7 +307,7 @@ pub struct Batched {
     /// The bake resolved for it.
     pub job: Job,
     /// What reading and baking changed from what was given (to state and record).
-    pub adjustments: Vec<crate::Adjustment>,
+    pub adjustments: Vec<crate::adjustment::Adjustment>,
     /// Its products, in host memory.
     pub baked: Baked,
 }

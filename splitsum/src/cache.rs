@@ -83,14 +83,14 @@ fn remove_entry(dir: &Path) -> Result<()> {
         Ok(m) if m.file_type().is_symlink() => return Err(foreign("is a symbolic link")),
         Ok(m) if !m.is_dir() => return Err(foreign("is not a folder")),
         Ok(_) => {}
-        Err(e) => return Err(Error::file(dir, format!("cannot read the cache entry: {e}"))),
+        Err(e) => return Err(Error::file_caused(dir, "cannot read the cache entry", e)),
     }
     #[cfg(not(target_arch = "wasm32"))]
     {
-        let entry = cap_std::fs::Dir::open_ambient_dir(dir, cap_std::ambient_authority()).map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))?;
+        let entry = cap_std::fs::Dir::open_ambient_dir(dir, cap_std::ambient_authority()).map_err(|e| Error::file_caused(dir, "cannot read the cache entry", e))?;
         let mut names = Vec::new();
-        for e in entry.entries().map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))? {
-            let e = e.map_err(|e| Error::file(dir, format!("cannot read the cache entry: {e}")))?;
+        for e in entry.entries().map_err(|e| Error::file_caused(dir, "cannot read the cache entry", e))? {
+            let e = e.map_err(|e| Error::file_caused(dir, "cannot read the cache entry", e))?;
             let name = e.file_name().to_string_lossy().into_owned();
             let is_file = e.file_type().is_ok_and(|t| t.is_file());
             if !is_file || !ENTRY_FILES.contains(&name.as_str()) {
@@ -99,10 +99,10 @@ fn remove_entry(dir: &Path) -> Result<()> {
             names.push(name);
         }
         for name in names {
-            entry.remove_file(&name).map_err(|err| Error::file(&dir.join(&name), format!("cannot remove the stale cache file: {err}")))?;
+            entry.remove_file(&name).map_err(|err| Error::file_caused(&dir.join(&name), "cannot remove the stale cache file", err))?;
         }
     }
-    std::fs::remove_dir(dir).map_err(|e| Error::file(dir, format!("cannot remove the stale cache entry: {e}")))
+    std::fs::remove_dir(dir).map_err(|e| Error::file_caused(dir, "cannot remove the stale cache entry", e))
 }
 
 /// What a lookup found.
@@ -158,7 +158,7 @@ impl Cache {
     /// same key take turns, and each after the first finds the entry the first stored. Says
     /// on stderr when it has to wait. Held until the returned file is dropped.
     pub fn lock(&self, key: &str) -> Result<std::fs::File> {
-        std::fs::create_dir_all(&self.dir).map_err(|e| Error::file(&self.dir, format!("cannot create the cache folder: {e}")))?;
+        std::fs::create_dir_all(&self.dir).map_err(|e| Error::file_caused(&self.dir, "cannot create the cache folder", e))?;
         let path = self.dir.join(format!("{key}.lock"));
         let mut options = std::fs::OpenOptions::new();
         options.create(true).truncate(false).write(true);
@@ -168,14 +168,14 @@ impl Cache {
         std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NOFOLLOW);
         let file = options
             .open(&path)
-            .map_err(|e| Error::file(&path, format!("cannot open the cache lock: {e}")))?;
+            .map_err(|e| Error::file_caused(&path, "cannot open the cache lock", e))?;
         match file.try_lock() {
             Ok(()) => {}
             Err(std::fs::TryLockError::WouldBlock) => {
                 crate::progress::note(&format!("waiting for another run that bakes the same scene (cache lock {})", path.display()));
-                file.lock().map_err(|e| Error::file(&path, format!("cannot lock: {e}")))?;
+                file.lock().map_err(|e| Error::file_caused(&path, "cannot lock", e))?;
             }
-            Err(std::fs::TryLockError::Error(e)) => return Err(Error::file(&path, format!("cannot lock: {e}"))),
+            Err(std::fs::TryLockError::Error(e)) => return Err(Error::file_caused(&path, "cannot lock", e)),
         }
         Ok(file)
     }
@@ -238,7 +238,7 @@ impl Cache {
 
     /// Stores `env` under `key` (atomically: a temporary folder renamed into place).
     pub fn put(&self, key: &str, env: &BakedEnvironment) -> Result<()> {
-        let fail = |e: std::io::Error| Error::file(&self.dir, format!("cannot write the cache: {e}"));
+        let fail = |e: std::io::Error| Error::file_caused(&self.dir, "cannot write the cache", e);
         std::fs::create_dir_all(&self.dir).map_err(fail)?;
         // A folder of a name nobody has (created new, never one found there): the files
         // below are written into this run's own folder.

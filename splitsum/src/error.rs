@@ -1,11 +1,19 @@
 //! Errors of the splitsum library, in its own terms: a setting by its field name, a file by
 //! its path. The command line maps them to the flags a user wrote (`runner`'s `cli`).
+//!
+//! A message says what splitsum could not do; what failed underneath (an I/O error, a
+//! decoder's, wgpu's) is its [`source`](std::error::Error::source), not part of the
+//! message, so that a caller printing the chain (`anyhow`'s `{:#}`) reads each cause once.
 
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-/// Something splitsum could not do.
+/// What failed underneath an [`Error`](enum@Error): an I/O error, a decoder's, wgpu's.
+pub type Cause = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// Something splitsum could not do. New kinds may be added: match with a wildcard arm.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum Error {
     /// No GPU adapter: the GPU backend cannot run here.
     #[error(
@@ -19,8 +27,14 @@ pub enum Error {
         detail: String,
     },
     /// The GPU device refused something (a pipeline, a buffer, a limit).
-    #[error("GPU: {0}")]
-    Gpu(String),
+    #[error("GPU: {problem}")]
+    Gpu {
+        /// What could not be done.
+        problem: String,
+        /// What wgpu (or the window system) said, if anything.
+        #[source]
+        cause: Option<Cause>,
+    },
     /// A file that could not be read, written or understood.
     #[error("{}: {problem}", path.display())]
     File {
@@ -28,6 +42,9 @@ pub enum Error {
         path: PathBuf,
         /// What is wrong with it.
         problem: String,
+        /// What failed underneath (the I/O error, the decoder's), if anything.
+        #[source]
+        cause: Option<Cause>,
     },
     /// An environment with NaN or infinite texels, read without sanitising.
     #[error(
@@ -68,7 +85,22 @@ pub enum Error {
 impl Error {
     /// A problem with the file at `path`.
     pub fn file(path: &Path, problem: impl Into<String>) -> Self {
-        Self::File { path: path.to_path_buf(), problem: problem.into() }
+        Self::File { path: path.to_path_buf(), problem: problem.into(), cause: None }
+    }
+
+    /// A problem with the file at `path`, because of `cause`.
+    pub fn file_caused(path: &Path, problem: impl Into<String>, cause: impl Into<Cause>) -> Self {
+        Self::File { path: path.to_path_buf(), problem: problem.into(), cause: Some(cause.into()) }
+    }
+
+    /// Something the GPU device refused.
+    pub fn gpu(problem: impl Into<String>) -> Self {
+        Self::Gpu { problem: problem.into(), cause: None }
+    }
+
+    /// Something the GPU device refused, because of `cause`.
+    pub fn gpu_caused(problem: impl Into<String>, cause: impl Into<Cause>) -> Self {
+        Self::Gpu { problem: problem.into(), cause: Some(cause.into()) }
     }
 
     /// A problem with field `field` of `Settings`.

@@ -203,7 +203,7 @@ static KEPT: std::sync::Mutex<Vec<(String, Estimator)>> = std::sync::Mutex::new(
 /// time are either a lucky run that nothing preempted or one that waited, while processor
 /// time over threads that spin for 40 ms averages the scheduler's share. A hardware GPU
 /// is timed by the wall clock.
-pub fn for_backend(backend: &crate::Backend) -> crate::error::Result<Estimator> {
+pub fn for_backend(backend: &crate::backend::Backend) -> crate::error::Result<Estimator> {
     if !crate::progress::shown() {
         return Ok(Estimator::built_in(backend.is_gpu()));
     }
@@ -232,17 +232,17 @@ pub fn for_backend(backend: &crate::Backend) -> crate::error::Result<Estimator> 
 /// The threads of this process that run `backend`'s work: rayon's for the CPU backend, a
 /// software GPU's (lavapipe and llvmpipe run one per processor, or `LP_NUM_THREADS`);
 /// `None` for a hardware GPU.
-fn processor_threads(backend: &crate::Backend) -> Option<u32> {
+fn processor_threads(backend: &crate::backend::Backend) -> Option<u32> {
     match backend {
-        crate::Backend::Cpu => Some(rayon::current_num_threads() as u32),
-        crate::Backend::Gpu(g) if g.is_software() => Some(
+        crate::backend::Backend::Cpu => Some(rayon::current_num_threads() as u32),
+        crate::backend::Backend::Gpu(g) if g.is_software() => Some(
             std::env::var("LP_NUM_THREADS")
                 .ok()
                 .and_then(|v| v.parse().ok())
                 .filter(|&n: &u32| n > 0)
                 .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get() as u32)),
         ),
-        crate::Backend::Gpu(_) => None,
+        crate::backend::Backend::Gpu(_) => None,
     }
 }
 
@@ -286,7 +286,7 @@ pub fn availability(threads: u32) -> f64 {
 /// where `job` is estimated, at the built-in rates, under half of [`SHOWN`] in all (a
 /// tiny bake, whose steps would show no estimate: measuring the device would take longer
 /// than the bake).
-pub fn for_job(backend: &crate::Backend, job: &Job) -> crate::error::Result<Estimator> {
+pub fn for_job(backend: &crate::backend::Backend, job: &Job) -> crate::error::Result<Estimator> {
     let kept = KEPT.lock().unwrap_or_else(|e| e.into_inner()).iter().any(|(k, _)| *k == backend.identity());
     if !kept && Estimator::built_in(backend.is_gpu()).total(job) < 0.5 * SHOWN {
         return Ok(Estimator::built_in(backend.is_gpu()));
@@ -295,7 +295,7 @@ pub fn for_job(backend: &crate::Backend, job: &Job) -> crate::error::Result<Esti
 }
 
 /// Keeps `est` as `backend`'s estimator for the rest of the process.
-pub fn keep(backend: &crate::Backend, est: Estimator) {
+pub fn keep(backend: &crate::backend::Backend, est: Estimator) {
     if !crate::progress::shown() || est.rates == Rates::BuiltIn {
         return;
     }
@@ -317,7 +317,7 @@ mod tests {
     #[test]
     fn the_correction_is_the_shrunk_geometric_mean_of_the_steps_seen() {
         let machine = Machine { filtered_reads: 1e9, summed_reads: 1e9, flops: 1e10 };
-        let job = crate::Settings::default().resolve(crate::InputShape::Equirect { width: 1024, height: 512 }, crate::Products::STANDARD).unwrap();
+        let job = crate::Settings::default().resolve(crate::environment::InputShape::Equirect { width: 1024, height: 512 }, crate::Products::STANDARD).unwrap();
         let mut e = Estimator::new(machine, false, Rates::Measured { seconds: 0.0 });
         let before = e.step(&job, Step::Specular);
         assert_eq!(before.within, MODEL_SPREAD);

@@ -19,121 +19,139 @@ fn check_lut_args(size: u32, samples: u32) -> Result<()> {
 }
 
 impl Backend {
-    /// The `size`×`size` BRDF table from `samples` points per texel.
-    pub fn brdf_lut(&self, size: u32, samples: u32) -> Result<Lut> {
-        check_lut_args(size, samples)?;
-        with_kernels!(self, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_lut(size, samples)?)?)))
-    }
-
-    /// The `size`×`size` BRDF table by deterministic quadrature with `masking`
-    /// (`lut::integrate_brdf_quadrature`).
-    pub fn brdf_table(&self, size: u32, masking: Masking) -> Result<Lut> {
-        check_lut_args(size, 1)?;
-        with_kernels!(self, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_table(size, masking)?)?)))
-    }
-
-    /// The source cube: `env` resampled to faces of `size` with `supersample`² points per
-    /// texel, the image centre facing `facing`, and its full mip chain.
-    pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Cube> {
-        let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
-        with_kernels!(self, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, facing)?)? }))
-    }
-
-    /// Fills levels 1.. of `cube` from its level 0.
-    pub fn build_mips(&self, cube: &mut Cube) -> Result<()> {
-        with_kernels!(self, k => {
-            let mut t = k.upload("cube", &cube.texels)?;
-            k.build_mips(&mut t, cube.layout)?;
-            cube.texels = k.read(&t)?;
-            Ok(())
-        })
-    }
-
-    /// The prefiltered specular cube with layout `out`, level `m` filtered for
-    /// `roughness[m]` with `samples` GGX samples and source-level bias `lod_bias`.
-    pub fn prefilter(&self, src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Result<Cube> {
-        let all: Vec<u32> = (0..out.levels).collect();
-        self.prefilter_levels(Lobe::Ggx, src, out, roughness, &all, &vec![samples; out.levels as usize], false, lod_bias)
-    }
-
-    /// As [`Backend::prefilter`] with the distribution `lobe` (GGX, or Charlie for the
-    /// sheen cube), baking only `levels`, level `m` from `samples[m]` samples, or with
-    /// `exact` summed exactly over a source level where that is cheaper
-    /// (`prefilter::exact_level`).
-    #[allow(clippy::too_many_arguments)]
-    pub fn prefilter_levels(
-        &self,
-        lobe: Lobe,
-        src: &Cube,
-        out: CubeLayout,
-        roughness: &[f32],
-        levels: &[u32],
-        samples: &[u32],
-        exact: bool,
-        lod_bias: f32,
-    ) -> Result<Cube> {
-        if samples.contains(&0) {
-            return Err(Error::setting(Field::Samples, "must be at least 1, not 0"));
+    internal! {
+        /// The `size`×`size` BRDF table from `samples` points per texel.
+        pub fn brdf_lut(&self, size: u32, samples: u32) -> Result<Lut> {
+            check_lut_args(size, samples)?;
+            with_kernels!(self, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_lut(size, samples)?)?)))
         }
-        let exact = crate::settings::exact_levels(lobe, roughness, samples, exact, src.layout);
-        let job = Prefilter { lobe, layout: out, roughness, levels, samples, exact: &exact, lod_bias };
-        with_kernels!(self, k => {
-            let t = k.upload("source cube", &src.texels)?;
-            Ok(Cube { layout: out, texels: k.read(&k.prefilter(&t, src.layout, &job)?)? })
-        })
     }
 
-    /// The irradiance cube (`E/π`) of face size `size` from level `level` of `src`.
-    pub fn irradiance(&self, src: &Cube, level: u32, size: u32) -> Result<Cube> {
-        with_kernels!(self, k => {
-            let t = k.upload("source cube", &src.texels)?;
-            Ok(Cube { layout: CubeLayout::new(size, 1), texels: k.read(&k.irradiance(&t, src.layout, level, size)?)? })
-        })
+    internal! {
+        /// The `size`×`size` BRDF table by deterministic quadrature with `masking`
+        /// (`lut::integrate_brdf_quadrature`).
+        pub fn brdf_table(&self, size: u32, masking: Masking) -> Result<Lut> {
+            check_lut_args(size, 1)?;
+            with_kernels!(self, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_table(size, masking)?)?)))
+        }
     }
 
-    /// The nine SH coefficients of radiance of level `level` of `src`.
-    pub fn sh9(&self, src: &Cube, level: u32) -> Result<Sh9> {
-        with_kernels!(self, k => k.sh9(&k.upload("source cube", &src.texels)?, src.layout, level))
+    internal! {
+        /// The source cube: `env` resampled to faces of `size` with `supersample`² points per
+        /// texel, the image centre facing `facing`, and its full mip chain.
+        pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Cube> {
+            let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
+            with_kernels!(self, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, facing)?)? }))
+        }
     }
 
-    /// Evaluates `probes` with `params` (see `kernels::probe_chunk`) over `cube`, if any:
-    /// the BRDF table `(A, B)` in `xy`, a prefiltered or irradiance mean, or a cube lookup.
-    pub fn probe(&self, params: ProbeParams, cube: Option<&Cube>, probes: &[Vec4]) -> Result<Vec<Vec4>> {
-        use splitsum_shaders::choice::Choice;
-        use splitsum_shaders::cubemap::FACES;
-        use splitsum_shaders::kernels::ProbeMode;
-        use splitsum_shaders::{lut, prefilter};
-        let texels: &[Vec4] = cube.map_or(&[], |c| &c.texels);
-        let p = ProbeParams {
-            count: probes.len() as u32,
-            probe_offset: texels.len() as u32,
-            src_size: cube.map_or(1, |c| c.layout.size),
-            src_levels: cube.map_or(1, |c| c.layout.levels),
-            ..params
-        };
-        let layout = CubeLayout::new(p.src_size, p.src_levels);
-        // Terms of the sum each probe runs, in chunks.
-        let mode = ProbeMode::from_code(p.mode);
-        let terms = match mode {
-            ProbeMode::Lut | ProbeMode::Prefilter => p.samples.max(1),
-            ProbeMode::Irradiance => FACES * layout.level_size(p.src_level).pow(2),
-            _ => 1,
-        };
-        let raw = with_kernels!(self, k => k.probe_raw(p, texels, probes, terms))?;
-        let partial = |i: usize| splitsum_shaders::math::MeanPartial { sum: raw[3 * i], carry: raw[3 * i + 1], weight: raw[3 * i + 2] };
-        Ok(raw
-            .chunks_exact(3)
-            .zip(probes)
-            .enumerate()
-            .map(|(i, (c, q))| match mode {
-                ProbeMode::Lut => lut::resolve(c[0], p.samples).extend(0.0).extend(0.0),
-                // A mirror is no sum: the lookup itself.
-                ProbeMode::Prefilter if splitsum_shaders::math::saturate(q.w) <= 0.0 => {
-                    prefilter::prefilter_dir(texels, layout, q.truncate(), 0.0, p.samples, p.lod_bias)
-                }
-                ProbeMode::Prefilter | ProbeMode::Irradiance => partial(i).resolve(),
-                _ => c[0],
+    internal! {
+        /// Fills levels 1.. of `cube` from its level 0.
+        pub fn build_mips(&self, cube: &mut Cube) -> Result<()> {
+            with_kernels!(self, k => {
+                let mut t = k.upload("cube", &cube.texels)?;
+                k.build_mips(&mut t, cube.layout)?;
+                cube.texels = k.read(&t)?;
+                Ok(())
             })
-            .collect())
+        }
+    }
+
+    internal! {
+        /// The prefiltered specular cube with layout `out`, level `m` filtered for
+        /// `roughness[m]` with `samples` GGX samples and source-level bias `lod_bias`.
+        pub fn prefilter(&self, src: &Cube, out: CubeLayout, roughness: &[f32], samples: u32, lod_bias: f32) -> Result<Cube> {
+            let all: Vec<u32> = (0..out.levels).collect();
+            self.prefilter_levels(Lobe::Ggx, src, out, roughness, &all, &vec![samples; out.levels as usize], false, lod_bias)
+        }
+    }
+
+    internal! {
+        /// As [`Backend::prefilter`] with the distribution `lobe` (GGX, or Charlie for the
+        /// sheen cube), baking only `levels`, level `m` from `samples[m]` samples, or with
+        /// `exact` summed exactly over a source level where that is cheaper
+        /// (`prefilter::exact_level`).
+        #[allow(clippy::too_many_arguments)]
+        pub fn prefilter_levels(
+            &self,
+            lobe: Lobe,
+            src: &Cube,
+            out: CubeLayout,
+            roughness: &[f32],
+            levels: &[u32],
+            samples: &[u32],
+            exact: bool,
+            lod_bias: f32,
+        ) -> Result<Cube> {
+            if samples.contains(&0) {
+                return Err(Error::setting(Field::Samples, "must be at least 1, not 0"));
+            }
+            let exact = crate::settings::exact_levels(lobe, roughness, samples, exact, src.layout);
+            let job = Prefilter { lobe, layout: out, roughness, levels, samples, exact: &exact, lod_bias };
+            with_kernels!(self, k => {
+                let t = k.upload("source cube", &src.texels)?;
+                Ok(Cube { layout: out, texels: k.read(&k.prefilter(&t, src.layout, &job)?)? })
+            })
+        }
+    }
+
+    internal! {
+        /// The irradiance cube (`E/π`) of face size `size` from level `level` of `src`.
+        pub fn irradiance(&self, src: &Cube, level: u32, size: u32) -> Result<Cube> {
+            with_kernels!(self, k => {
+                let t = k.upload("source cube", &src.texels)?;
+                Ok(Cube { layout: CubeLayout::new(size, 1), texels: k.read(&k.irradiance(&t, src.layout, level, size)?)? })
+            })
+        }
+    }
+
+    internal! {
+        /// The nine SH coefficients of radiance of level `level` of `src`.
+        pub fn sh9(&self, src: &Cube, level: u32) -> Result<Sh9> {
+            with_kernels!(self, k => k.sh9(&k.upload("source cube", &src.texels)?, src.layout, level))
+        }
+    }
+
+    internal! {
+        /// Evaluates `probes` with `params` (see `kernels::probe_chunk`) over `cube`, if any:
+        /// the BRDF table `(A, B)` in `xy`, a prefiltered or irradiance mean, or a cube lookup.
+        pub fn probe(&self, params: ProbeParams, cube: Option<&Cube>, probes: &[Vec4]) -> Result<Vec<Vec4>> {
+            use splitsum_shaders::choice::Choice;
+            use splitsum_shaders::cubemap::FACES;
+            use splitsum_shaders::kernels::ProbeMode;
+            use splitsum_shaders::{lut, prefilter};
+            let texels: &[Vec4] = cube.map_or(&[], |c| &c.texels);
+            let p = ProbeParams {
+                count: probes.len() as u32,
+                probe_offset: texels.len() as u32,
+                src_size: cube.map_or(1, |c| c.layout.size),
+                src_levels: cube.map_or(1, |c| c.layout.levels),
+                ..params
+            };
+            let layout = CubeLayout::new(p.src_size, p.src_levels);
+            // Terms of the sum each probe runs, in chunks.
+            let mode = ProbeMode::from_code(p.mode);
+            let terms = match mode {
+                ProbeMode::Lut | ProbeMode::Prefilter => p.samples.max(1),
+                ProbeMode::Irradiance => FACES * layout.level_size(p.src_level).pow(2),
+                _ => 1,
+            };
+            let raw = with_kernels!(self, k => k.probe_raw(p, texels, probes, terms))?;
+            let partial = |i: usize| splitsum_shaders::math::MeanPartial { sum: raw[3 * i], carry: raw[3 * i + 1], weight: raw[3 * i + 2] };
+            Ok(raw
+                .chunks_exact(3)
+                .zip(probes)
+                .enumerate()
+                .map(|(i, (c, q))| match mode {
+                    ProbeMode::Lut => lut::resolve(c[0], p.samples).extend(0.0).extend(0.0),
+                    // A mirror is no sum: the lookup itself.
+                    ProbeMode::Prefilter if splitsum_shaders::math::saturate(q.w) <= 0.0 => {
+                        prefilter::prefilter_dir(texels, layout, q.truncate(), 0.0, p.samples, p.lod_bias)
+                    }
+                    ProbeMode::Prefilter | ProbeMode::Irradiance => partial(i).resolve(),
+                    _ => c[0],
+                })
+                .collect())
+        }
     }
 }

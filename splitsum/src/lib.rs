@@ -28,8 +28,9 @@
 //!   name the field ([`Error::Setting`], [`Field`]).
 //! - [`environment`] reads `.hdr`, `.exr` and six-face folders, with bounded memory;
 //!   [`output::write`] writes the files of a [`Target`] (splitsum's folder, or what the glTF
-//!   Sample Viewer, Bevy or Filament load) as a folder replaced whole; [`bake()`] bakes
-//!   into host memory on a [`Backend`] for tools that need no device of their own.
+//!   Sample Viewer, Bevy or Filament load) as a folder replaced whole;
+//!   [`low_level::bake`] bakes into host memory on a [`low_level::Backend`] for tools that
+//!   need no device of their own.
 //! - Every formula lives in `splitsum-shaders` (no_std), compiled by rust-gpu to the SPIR-V
 //!   module committed in `splitsum-spirv` and natively for the CPU.
 //!
@@ -59,21 +60,34 @@ macro_rules! internal_modules {
     };
 }
 
-pub mod adjustment;
+/// Declares one item public with the `internals` feature and visible to the crate alone
+/// without it: what the command line, its display and its report need from a public module
+/// beyond the stable API.
+macro_rules! internal {
+    ($(#[$meta:meta])* pub $($item:tt)*) => {
+        $(#[$meta])*
+        #[cfg(feature = "internals")]
+        pub $($item)*
+        $(#[$meta])*
+        #[cfg(not(feature = "internals"))]
+        #[allow(dead_code)]
+        pub(crate) $($item)*
+    };
+}
+
 pub mod environment;
-pub mod error;
-pub mod field;
 pub mod output;
-pub mod settings;
 pub mod texture;
-pub mod textures;
 
 internal_modules! {
+    adjustment;
     backend;
     bake;
     cache;
     cost;
+    error;
     estimate;
+    field;
     files;
     host;
     ktx1;
@@ -81,23 +95,39 @@ internal_modules! {
     measured;
     preview;
     progress;
+    settings;
     table;
+    textures;
 }
 
-pub use adjustment::Adjustment;
-pub use crate::backend::{Backend, BackendKind, Gpu};
-pub use crate::bake::{Baked, Batched, Timing, bake, bake_batch, bake_job};
-pub use environment::{Environment, InputReport, InputShape};
 pub use error::{Error, Result};
-pub use field::{Field, Step};
-pub use crate::ktx2::Written;
-pub use texture::Format;
-pub use output::{About, Manifest};
-pub use settings::{Job, Products, Settings, TableMethod, Target};
+pub use settings::{Field, Job, Products, Settings, TableMethod, Target};
 pub use splitsum_shaders::brdf::microfacet::Masking;
-pub use splitsum_shaders::choice::Choice;
-pub use splitsum_shaders::cubemap::CubeLayout;
 pub use splitsum_shaders::equirect::Facing;
-pub use splitsum_shaders::glam;
 pub use splitsum_shaders::prefilter::RoughnessMapping;
 pub use textures::{Baker, Compute, Ibl, IblViews, SheenTextures, Source};
+
+pub mod low_level {
+    //! Baking into host memory on a [`Backend`] of splitsum's own, for tools that need no
+    //! device of theirs: [`bake()`] and [`bake_batch`] (one device for many environments,
+    //! the next read and the last written while one bakes), and what they return.
+    pub use crate::adjustment::Adjustment;
+    pub use crate::backend::{Backend, BackendKind, Gpu};
+    pub use crate::bake::{Baked, Batched, Made, Timing, bake, bake_batch};
+    pub use crate::field::Step;
+}
+
+// The workbench of the command line, its display and its report (`internals`): the names
+// they read from the crate root.
+#[cfg(feature = "internals")]
+pub use crate::{
+    backend::{Backend, BackendKind, Gpu},
+    bake::{Baked, Batched, Timing, bake, bake_batch, bake_job},
+    environment::{Environment, InputReport, InputShape},
+    field::Step,
+    ktx2::Written,
+    output::{About, Manifest},
+    texture::Format,
+};
+#[cfg(feature = "internals")]
+pub use splitsum_shaders::{choice::Choice, cubemap::CubeLayout, glam};

@@ -1,6 +1,6 @@
 //! A bake written as a folder: for the `splitsum` target, KTX2 cubes, EXR and PNG views of
 //! each product, the SH9 coefficients; for an engine target, the files its engine loads,
-//! named and encoded as its own baker writes them ([`engine_files`]); and always
+//! named and encoded as its own baker writes them (`engine_files`); and always
 //! `bake.json` (what was baked, how, from what, and how long it took).
 
 use crate::bake::{Baked, Timing};
@@ -87,7 +87,7 @@ pub struct ShError {
 }
 
 /// Compares SH9 irradiance with the irradiance cube texel by texel.
-pub fn sh9_error(sh: &Sh9, irradiance: &Cube) -> ShError {
+pub(crate) fn sh9_error(sh: &Sh9, irradiance: &Cube) -> ShError {
     use splitsum_shaders::{cubemap, irradiance::sh9_irradiance, tonemap::luminance};
     let coeffs = sh.as_vec4();
     let s = irradiance.layout.size;
@@ -160,128 +160,130 @@ pub fn write(out: &Path, baked: &Baked, job: &Job, about: About) -> Result<Manif
     Ok(manifest)
 }
 
-/// [`write()`] into the folder `dir` as it is (created if missing), each file atomically and
-/// `bake.json` last.
-pub fn write_into(dir: &Path, name: &str, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
-    let _step = crate::progress::step("writing the files", None);
-    files::create_folder(dir)?;
-    let mut manifest = Manifest {
-        environment: about.environment,
-        backend: about.backend,
-        settings: job.clone(),
-        roughness_per_mip: job.roughness_per_mip.clone(),
-        samples_per_mip: job.samples_per_mip.clone(),
-        accuracy: DEFAULTS_ACCURACY,
-        input: about.input.as_ref().map(InputSummary::from),
-        adjustments: Vec::new(),
-        timings: baked.timings.clone(),
-        sh9_vs_convolution: None,
-        files: Vec::new(),
-        conventions: target_conventions(job.target).to_vec(),
-    };
-    manifest.adjustments = about.input.as_ref().map_or_else(Vec::new, |input| input.adjustments_for(job.input));
-    manifest.adjustments.extend(job.adjustments());
-    if job.target != Target::Splitsum {
-        manifest.files = engine_files(dir, name, baked, job)?;
-        return write_manifest(dir, manifest);
-    }
-    // Each file is a job of its own, run on every core at once; the manifest lists them
-    // in this order.
-    type Job<'a> = Box<dyn FnOnce() -> Result<Vec<OutputFile>> + Send + 'a>;
-    let mut jobs: Vec<Job<'_>> = Vec::new();
-    let file = |name: &str, what: String, written: Option<ktx2::Written>| OutputFile { name: name.to_string(), what, written };
-    // Previews at the source's exposure (the specular cube's mip 0 where no source was kept).
-    let sky = baked.source.as_ref().or(baked.specular.as_ref());
-    let exposure = sky.map_or(1.0, preview::auto_exposure);
-    let save_png = move |name: &str, pic: &preview::Picture| -> Result<()> {
-        files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
-    };
-    if let Some(source) = &baked.source {
-        jobs.push(Box::new(move || {
-            save_png("preview_source.png", &preview::cross(source, 0, job.source_size.min(256)))?;
-            Ok(vec![file("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None)])
-        }));
-    }
-    if let Some(spec) = &baked.specular {
-        jobs.push(Box::new(move || {
-            let w = ktx2::write(&dir.join("specular.ktx2"), spec, job.format)?;
-            report_clamp("specular.ktx2", &w);
-            Ok(vec![file("specular.ktx2", "GGX-prefiltered radiance, one roughness per mip (roughness_per_mip)".into(), Some(w))])
-        }));
-        for m in 0..spec.layout.levels {
+internal! {
+    /// [`write()`] into the folder `dir` as it is (created if missing), each file atomically and
+    /// `bake.json` last.
+    pub fn write_into(dir: &Path, name: &str, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
+        let _step = crate::progress::step("writing the files", None);
+        files::create_folder(dir)?;
+        let mut manifest = Manifest {
+            environment: about.environment,
+            backend: about.backend,
+            settings: job.clone(),
+            roughness_per_mip: job.roughness_per_mip.clone(),
+            samples_per_mip: job.samples_per_mip.clone(),
+            accuracy: DEFAULTS_ACCURACY,
+            input: about.input.as_ref().map(InputSummary::from),
+            adjustments: Vec::new(),
+            timings: baked.timings.clone(),
+            sh9_vs_convolution: None,
+            files: Vec::new(),
+            conventions: target_conventions(job.target).to_vec(),
+        };
+        manifest.adjustments = about.input.as_ref().map_or_else(Vec::new, |input| input.adjustments_for(job.input));
+        manifest.adjustments.extend(job.adjustments());
+        if job.target != Target::Splitsum {
+            manifest.files = engine_files(dir, name, baked, job)?;
+            return write_manifest(dir, manifest);
+        }
+        // Each file is a job of its own, run on every core at once; the manifest lists them
+        // in this order.
+        type Job<'a> = Box<dyn FnOnce() -> Result<Vec<OutputFile>> + Send + 'a>;
+        let mut jobs: Vec<Job<'_>> = Vec::new();
+        let file = |name: &str, what: String, written: Option<ktx2::Written>| OutputFile { name: name.to_string(), what, written };
+        // Previews at the source's exposure (the specular cube's mip 0 where no source was kept).
+        let sky = baked.source.as_ref().or(baked.specular.as_ref());
+        let exposure = sky.map_or(1.0, preview::auto_exposure);
+        let save_png = move |name: &str, pic: &preview::Picture| -> Result<()> {
+            files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
+        };
+        if let Some(source) = &baked.source {
             jobs.push(Box::new(move || {
-                let name = format!("specular_mip{m}.exr");
-                files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip[m as usize]))?;
-                Ok(vec![file(&name, format!("mip {m} as EXR for inspection"), None)])
+                save_png("preview_source.png", &preview::cross(source, 0, job.source_size.min(256)))?;
+                Ok(vec![file("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None)])
             }));
         }
-        jobs.push(Box::new(move || {
-            save_png("preview_specular.png", &preview::mip_strip(spec, 64))?;
-            Ok(vec![file("preview_specular.png", "every specular mip as a cross, roughness rising to the right".into(), None)])
-        }));
+        if let Some(spec) = &baked.specular {
+            jobs.push(Box::new(move || {
+                let w = ktx2::write(&dir.join("specular.ktx2"), spec, job.format)?;
+                report_clamp("specular.ktx2", &w);
+                Ok(vec![file("specular.ktx2", "GGX-prefiltered radiance, one roughness per mip (roughness_per_mip)".into(), Some(w))])
+            }));
+            for m in 0..spec.layout.levels {
+                jobs.push(Box::new(move || {
+                    let name = format!("specular_mip{m}.exr");
+                    files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip[m as usize]))?;
+                    Ok(vec![file(&name, format!("mip {m} as EXR for inspection"), None)])
+                }));
+            }
+            jobs.push(Box::new(move || {
+                save_png("preview_specular.png", &preview::mip_strip(spec, 64))?;
+                Ok(vec![file("preview_specular.png", "every specular mip as a cross, roughness rising to the right".into(), None)])
+            }));
+        }
+        if let Some(irr) = &baked.irradiance {
+            jobs.push(Box::new(move || {
+                let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, job.format)?;
+                report_clamp("irradiance.ktx2", &w);
+                files::write_cube_level_exr(&dir.join("irradiance.exr"), irr, 0, "irradiance / pi")?;
+                save_png("preview_irradiance.png", &preview::cross(irr, 0, 64))?;
+                Ok(vec![
+                    file("irradiance.ktx2", "irradiance divided by π (cosine-weighted mean radiance)".into(), Some(w)),
+                    file("irradiance.exr", "the irradiance cube as EXR for inspection".into(), None),
+                    file("preview_irradiance.png", "the irradiance cube as a cross".into(), None),
+                ])
+            }));
+        }
+        if let Some(sh) = &baked.sh9 {
+            jobs.push(Box::new(move || {
+                let file_contents = ShFile {
+                    convention: "real SH (Sloan 2008), radiance L_lm = sum L Y_lm dOmega; E(n)/pi = sum (A_l/pi) L_lm Y_lm(n), A_l/pi = 1, 2/3, 1/4",
+                    order: ["0,0", "1,-1", "1,0", "1,1", "2,-2", "2,-1", "2,0", "2,1", "2,2"],
+                    radiance: sh.radiance,
+                    irradiance_over_pi: std::array::from_fn(|k| sh.radiance[k].map(|v| v * SH9_COSINE[k] as f64)),
+                };
+                let json = serde_json::to_string_pretty(&file_contents).expect("serialisable");
+                files::write_atomic(&dir.join("sh9.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+                Ok(vec![file("sh9.json", format!("{SH9} spherical-harmonic coefficients of radiance and of E/π"), None)])
+            }));
+        }
+        if let Some(lut) = &baked.lut {
+            jobs.push(Box::new(move || {
+                files::write_lut_exr(&dir.join("brdf_lut.exr"), lut)?;
+                files::write_png(&dir.join("brdf_lut.png"), lut.size, lut.size, &files::lut_preview(lut))?;
+                Ok(vec![
+                    file("brdf_lut.exr", "split-sum BRDF table: R = scale, G = bias; x = n·v, y = roughness".into(), None),
+                    file("brdf_lut.png", "its 8-bit preview".into(), None),
+                ])
+            }));
+        }
+        if let (Some(sheen), Some(tables)) = (&baked.sheen, &baked.sheen_tables) {
+            jobs.push(Box::new(move || {
+                let w = ktx2::write(&dir.join("sheen.ktx2"), sheen, job.format)?;
+                report_clamp("sheen.ktx2", &w);
+                files::write_lut_exr(&dir.join("sheen_tables.exr"), tables)?;
+                save_png("preview_sheen.png", &preview::mip_strip(sheen, 64))?;
+                Ok(vec![
+                    file("sheen.ktx2", "Charlie-prefiltered radiance (sheen), mip m at sheen roughness m/(mips-1) (sheen_roughness_per_mip)".into(), Some(w)),
+                    file(
+                        "sheen_tables.exr",
+                        "sheen tables: R = Charlie table (Neubelt visibility; the glTF Sample Viewer's lut_charlie), G = sheen albedo (Charlie visibility; lut_sheen_E); x = n·v, y = sheen roughness".into(),
+                        None,
+                    ),
+                    file("preview_sheen.png", "every sheen mip as a cross, sheen roughness rising to the right".into(), None),
+                ])
+            }));
+        }
+        let files_out: Vec<OutputFile> = {
+            use rayon::prelude::*;
+            jobs.into_par_iter().map(|j| j()).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect()
+        };
+        manifest.files = files_out;
+        if let (Some(sh), Some(irr)) = (&baked.sh9, &baked.irradiance) {
+            manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
+        }
+        write_manifest(dir, manifest)
     }
-    if let Some(irr) = &baked.irradiance {
-        jobs.push(Box::new(move || {
-            let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, job.format)?;
-            report_clamp("irradiance.ktx2", &w);
-            files::write_cube_level_exr(&dir.join("irradiance.exr"), irr, 0, "irradiance / pi")?;
-            save_png("preview_irradiance.png", &preview::cross(irr, 0, 64))?;
-            Ok(vec![
-                file("irradiance.ktx2", "irradiance divided by π (cosine-weighted mean radiance)".into(), Some(w)),
-                file("irradiance.exr", "the irradiance cube as EXR for inspection".into(), None),
-                file("preview_irradiance.png", "the irradiance cube as a cross".into(), None),
-            ])
-        }));
-    }
-    if let Some(sh) = &baked.sh9 {
-        jobs.push(Box::new(move || {
-            let file_contents = ShFile {
-                convention: "real SH (Sloan 2008), radiance L_lm = sum L Y_lm dOmega; E(n)/pi = sum (A_l/pi) L_lm Y_lm(n), A_l/pi = 1, 2/3, 1/4",
-                order: ["0,0", "1,-1", "1,0", "1,1", "2,-2", "2,-1", "2,0", "2,1", "2,2"],
-                radiance: sh.radiance,
-                irradiance_over_pi: std::array::from_fn(|k| sh.radiance[k].map(|v| v * SH9_COSINE[k] as f64)),
-            };
-            let json = serde_json::to_string_pretty(&file_contents).expect("serialisable");
-            files::write_atomic(&dir.join("sh9.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
-            Ok(vec![file("sh9.json", format!("{SH9} spherical-harmonic coefficients of radiance and of E/π"), None)])
-        }));
-    }
-    if let Some(lut) = &baked.lut {
-        jobs.push(Box::new(move || {
-            files::write_lut_exr(&dir.join("brdf_lut.exr"), lut)?;
-            files::write_png(&dir.join("brdf_lut.png"), lut.size, lut.size, &files::lut_preview(lut))?;
-            Ok(vec![
-                file("brdf_lut.exr", "split-sum BRDF table: R = scale, G = bias; x = n·v, y = roughness".into(), None),
-                file("brdf_lut.png", "its 8-bit preview".into(), None),
-            ])
-        }));
-    }
-    if let (Some(sheen), Some(tables)) = (&baked.sheen, &baked.sheen_tables) {
-        jobs.push(Box::new(move || {
-            let w = ktx2::write(&dir.join("sheen.ktx2"), sheen, job.format)?;
-            report_clamp("sheen.ktx2", &w);
-            files::write_lut_exr(&dir.join("sheen_tables.exr"), tables)?;
-            save_png("preview_sheen.png", &preview::mip_strip(sheen, 64))?;
-            Ok(vec![
-                file("sheen.ktx2", "Charlie-prefiltered radiance (sheen), mip m at sheen roughness m/(mips-1) (sheen_roughness_per_mip)".into(), Some(w)),
-                file(
-                    "sheen_tables.exr",
-                    "sheen tables: R = Charlie table (Neubelt visibility; the glTF Sample Viewer's lut_charlie), G = sheen albedo (Charlie visibility; lut_sheen_E); x = n·v, y = sheen roughness".into(),
-                    None,
-                ),
-                file("preview_sheen.png", "every sheen mip as a cross, sheen roughness rising to the right".into(), None),
-            ])
-        }));
-    }
-    let files_out: Vec<OutputFile> = {
-        use rayon::prelude::*;
-        jobs.into_par_iter().map(|j| j()).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect()
-    };
-    manifest.files = files_out;
-    if let (Some(sh), Some(irr)) = (&baked.sh9, &baked.irradiance) {
-        manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
-    }
-    write_manifest(dir, manifest)
 }
 
 fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
@@ -305,7 +307,7 @@ fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
 /// - `filament`: `NAME_ibl.ktx` (specular mips, KTX 1.1 `R11F_G11F_B10F`, SH in its `sh`
 ///   metadata), `NAME_skybox.ktx` (the source cube's level 0) and `sh.txt`: cmgen
 ///   `--format=ktx --deploy`.
-pub fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> Result<Vec<OutputFile>> {
+pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> Result<Vec<OutputFile>> {
     let mut out = Vec::new();
     let mut add = |name: String, what: &str, written: Option<ktx2::Written>| {
         out.push(OutputFile { name, what: what.into(), written });
@@ -393,7 +395,7 @@ pub fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> Result<
 }
 
 /// The conventions of `target`'s files, stated in its manifest.
-pub fn target_conventions(target: Target) -> &'static [&'static str] {
+pub(crate) fn target_conventions(target: Target) -> &'static [&'static str] {
     match target {
         Target::Splitsum => &CONVENTIONS,
         Target::Khronos | Target::Bevy => &[
@@ -431,10 +433,10 @@ fn report_clamp(name: &str, w: &ktx2::Written) {
 
 /// What `runner report` measured for the default settings (city.exr, 1024×512 with a
 /// 34 000 sun; the figures the README quotes), stated in every manifest.
-pub const DEFAULTS_ACCURACY: &str = "defaults (256² cube, 6 mips, geometric roughness, 64 GGX samples at mip 1 doubling per mip, the r = 1 mip summed exactly, dominant-direction lookup lifted above the horizon and blended between mips in log luminance, table by quadrature with exact Smith) on city.exr: shaded colour against the full reflectance integral (exact Smith, f64), mean relative error 15.1 % over roughness 0.02-1 and all views (the seed method: 32 %), of which the bake adds 2-3.5 % per view band and the split-sum approximation 7-37 %; prefiltered lookup at any roughness 5.7 % mean (seed 12.7 %); over 8 held-out environments 20.1 % with one fetch, 12.8 % with 16 (runner report --sets, --fetches); BRDF table max error 6.2e-6; bake 0.85 s on lavapipe, 1.58 s on 2 CPU cores (runner report, runner bench)";
+pub(crate) const DEFAULTS_ACCURACY: &str = "defaults (256² cube, 6 mips, geometric roughness, 64 GGX samples at mip 1 doubling per mip, the r = 1 mip summed exactly, dominant-direction lookup lifted above the horizon and blended between mips in log luminance, table by quadrature with exact Smith) on city.exr: shaded colour against the full reflectance integral (exact Smith, f64), mean relative error 15.1 % over roughness 0.02-1 and all views (the seed method: 32 %), of which the bake adds 2-3.5 % per view band and the split-sum approximation 7-37 %; prefiltered lookup at any roughness 5.7 % mean (seed 12.7 %); over 8 held-out environments 20.1 % with one fetch, 12.8 % with 16 (runner report --sets, --fetches); BRDF table max error 6.2e-6; bake 0.85 s on lavapipe, 1.58 s on 2 CPU cores (runner report, runner bench)";
 
 /// The conventions stated in every manifest.
-pub const CONVENTIONS: [&str; 5] = [
+pub(crate) const CONVENTIONS: [&str; 5] = [
     "cube faces +X -X +Y -Y +Z -Z, Vulkan/KTX2 orientation (OpenGL 4.6 table 8.19)",
     "equirect: image centre looks down -Z, +Y up; u = 0.5 + atan2(x, -z)/2pi, v = polar angle/pi",
     "specular mip m holds roughness roughness_per_mip[m] (alpha = roughness^2), GGX with n = v = r; sheen mip m holds sheen roughness sheen_roughness_per_mip[m], Charlie with n = v",

@@ -94,35 +94,37 @@ impl Sh9 {
     }
 }
 
-/// The mip chain of an RGBA8 image down to 1×1, level 0 first, by a 2×2 box filter
-/// (averaged in linear light when `srgb`). Odd sizes take the last row/column once.
-pub fn mip_chain_rgba8(width: u32, height: u32, rgba: &[u8], srgb: bool) -> Vec<(u32, u32, Vec<u8>)> {
-    use splitsum_shaders::tonemap::{linear_to_srgb, srgb_to_linear};
-    let decode = |v: u8, k: usize| if srgb && k < 3 { srgb_to_linear(v as f32 / 255.0) } else { v as f32 / 255.0 };
-    let encode = |v: f32, k: usize| {
-        let e = if srgb && k < 3 { linear_to_srgb(v) } else { v };
-        (e.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
-    };
-    let mut levels = vec![(width, height, rgba.to_vec())];
-    while let Some((w, h, data)) = levels.last().filter(|(w, h, _)| *w > 1 || *h > 1) {
-        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-        let mut next = vec![0u8; (4 * nw * nh) as usize];
-        for y in 0..nh {
-            for x in 0..nw {
-                for k in 0..4 {
-                    let mut acc = 0.0;
-                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                        let sx = (2 * x + dx).min(w - 1);
-                        let sy = (2 * y + dy).min(h - 1);
-                        acc += decode(data[(4 * (sy * w + sx)) as usize + k], k);
+internal! {
+    /// The mip chain of an RGBA8 image down to 1×1, level 0 first, by a 2×2 box filter
+    /// (averaged in linear light when `srgb`). Odd sizes take the last row/column once.
+    pub fn mip_chain_rgba8(width: u32, height: u32, rgba: &[u8], srgb: bool) -> Vec<(u32, u32, Vec<u8>)> {
+        use splitsum_shaders::tonemap::{linear_to_srgb, srgb_to_linear};
+        let decode = |v: u8, k: usize| if srgb && k < 3 { srgb_to_linear(v as f32 / 255.0) } else { v as f32 / 255.0 };
+        let encode = |v: f32, k: usize| {
+            let e = if srgb && k < 3 { linear_to_srgb(v) } else { v };
+            (e.clamp(0.0, 1.0) * 255.0 + 0.5) as u8
+        };
+        let mut levels = vec![(width, height, rgba.to_vec())];
+        while let Some((w, h, data)) = levels.last().filter(|(w, h, _)| *w > 1 || *h > 1) {
+            let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+            let mut next = vec![0u8; (4 * nw * nh) as usize];
+            for y in 0..nh {
+                for x in 0..nw {
+                    for k in 0..4 {
+                        let mut acc = 0.0;
+                        for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                            let sx = (2 * x + dx).min(w - 1);
+                            let sy = (2 * y + dy).min(h - 1);
+                            acc += decode(data[(4 * (sy * w + sx)) as usize + k], k);
+                        }
+                        next[(4 * (y * nw + x)) as usize + k] = encode(acc / 4.0, k);
                     }
-                    next[(4 * (y * nw + x)) as usize + k] = encode(acc / 4.0, k);
                 }
             }
+            levels.push((nw, nh, next));
         }
-        levels.push((nw, nh, next));
+        levels
     }
-    levels
 }
 
 /// Texel format of a written cube (KTX2, KTX 1.1 by its Vulkan twin: `crate::ktx2`).

@@ -569,7 +569,7 @@ async fn read_halves(device: &wgpu::Device, queue: &wgpu::Queue, t: &wgpu::Textu
             wgpu::Extent3d { width: s, height: s, depth_or_array_layers: layers },
         );
         queue.submit([encoder.finish()]);
-        let bytes = gpu::map_read_async(device, &buffer).await.map_err(|e| Error::Gpu(format!("{e} ({:?} {:?}, mip {m} of {})", t.format(), t.size(), t.mip_level_count())))?;
+        let bytes = gpu::map_read_async(device, &buffer).await.map_err(|e| Error::gpu(format!("{e} ({:?} {:?}, mip {m} of {})", t.format(), t.size(), t.mip_level_count())))?;
         let words: &[u32] = bytemuck::cast_slice(&bytes);
         for r in 0..(s * layers) as usize {
             let w = &words[r * (row / 4) as usize..];

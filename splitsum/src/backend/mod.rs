@@ -91,12 +91,14 @@ impl Backend {
         }
     }
 
-    /// What the backend's results depend on, for cache keys: the adapter and driver, or
-    /// `cpu` (results on the CPU do not depend on the number of threads).
-    pub fn identity(&self) -> String {
-        match self {
-            Backend::Gpu(g) => format!("gpu: {}", g.describe()),
-            Backend::Cpu => "cpu".into(),
+    internal! {
+        /// What the backend's results depend on, for cache keys: the adapter and driver, or
+        /// `cpu` (results on the CPU do not depend on the number of threads).
+        pub fn identity(&self) -> String {
+            match self {
+                Backend::Gpu(g) => format!("gpu: {}", g.describe()),
+                Backend::Cpu => "cpu".into(),
+            }
         }
     }
 

@@ -31,7 +31,7 @@ pub const MAX_SIDE: u32 = 32768;
 /// Largest cube face accepted (faces are reduced as they are decoded, as equirects are).
 pub const MAX_FACE: u32 = MAX_SIDE;
 /// Smallest equirect accepted.
-pub const MIN_WIDTH: u32 = 8;
+pub(crate) const MIN_WIDTH: u32 = 8;
 
 /// An environment as read: an equirect image or a cube.
 #[derive(Clone, Debug)]
@@ -44,7 +44,7 @@ pub enum Environment {
 
 impl Environment {
     /// The environment's own resolution as a cube face size (a quarter of an equirect's
-    /// width, as a power of two, at most [`NATIVE_FACE`]).
+    /// width, as a power of two, at most 1024).
     pub fn native_face_size(&self) -> u32 {
         self.resolves().min(NATIVE_FACE)
     }
@@ -106,7 +106,7 @@ pub struct InputReport {
     pub max_value: f32,
     /// Width and height of the file (of one face, for a cube), before any reduction.
     pub original: (u32, u32),
-    /// The cube face size the environment was read for (see [`load_for`]).
+    /// The cube face size the environment was read for.
     pub read_for: u32,
 }
 
@@ -150,32 +150,36 @@ impl InputReport {
 /// Face file names of a cube map folder, in KTX2/Vulkan face order.
 pub const FACE_NAMES: [&str; 6] = ["px", "nx", "py", "ny", "pz", "nz"];
 
-/// The largest cube face the display and the planner build from an environment (see
-/// `Environment::native_face_size`): what [`load`] reads an environment for.
-pub const NATIVE_FACE: u32 = 1024;
+internal! {
+    /// The largest cube face the display and the planner build from an environment (see
+    /// `Environment::native_face_size`): what [`load`] reads an environment for.
+    pub const NATIVE_FACE: u32 = 1024;
+}
 
-/// Reads an environment for cubes of faces up to [`NATIVE_FACE`] (see [`load_for`]).
+/// Reads an environment for cubes of faces up to 1024 wide.
 pub fn load(path: &Path, sanitize: bool) -> Result<(Environment, InputReport)> {
     load_for(path, sanitize, NATIVE_FACE)
 }
 
-/// Reads an environment: a `.hdr`/`.exr` equirect file, or a folder holding six faces
-/// `px nx py ny pz nz` (`.hdr` or `.exr`) in Vulkan/KTX2 orientation, keeping only the
-/// resolution a cube of faces `face` wide resolves: an equirect is reduced by
-/// `equirect::reduction_factor` (area-weighted, as it is decoded, so a 16384×8192 file is
-/// never held whole), and faces wider than `face` are reduced to `face` through the cube's
-/// own mip filter. [`InputReport::original`] keeps the size of the file.
-pub fn load_for(path: &Path, sanitize: bool, face: u32) -> Result<(Environment, InputReport)> {
-    if path.is_dir() {
-        let faces = face_paths(path)?;
-        let (env, report) = load_faces(&faces, sanitize, face)?;
-        return Ok((env, InputReport { read_for: face, ..report }));
+internal! {
+    /// Reads an environment: a `.hdr`/`.exr` equirect file, or a folder holding six faces
+    /// `px nx py ny pz nz` (`.hdr` or `.exr`) in Vulkan/KTX2 orientation, keeping only the
+    /// resolution a cube of faces `face` wide resolves: an equirect is reduced by
+    /// `equirect::reduction_factor` (area-weighted, as it is decoded, so a 16384×8192 file is
+    /// never held whole), and faces wider than `face` are reduced to `face` through the cube's
+    /// own mip filter. [`InputReport::original`] keeps the size of the file.
+    pub fn load_for(path: &Path, sanitize: bool, face: u32) -> Result<(Environment, InputReport)> {
+        if path.is_dir() {
+            let faces = face_paths(path)?;
+            let (env, report) = load_faces(&faces, sanitize, face)?;
+            return Ok((env, InputReport { read_for: face, ..report }));
+        }
+        let (width, height) = dimensions(path)?;
+        check_equirect_shape(path, width, height)?;
+        let factor = equirect::reduction_factor(width, height, face);
+        let (image, report) = read_reduced(path, sanitize, factor)?;
+        Ok((Environment::Equirect(image), InputReport { read_for: face, ..report }))
     }
-    let (width, height) = dimensions(path)?;
-    check_equirect_shape(path, width, height)?;
-    let factor = equirect::reduction_factor(width, height, face);
-    let (image, report) = read_reduced(path, sanitize, factor)?;
-    Ok((Environment::Equirect(image), InputReport { read_for: face, ..report }))
 }
 
 /// The six face files of a cube map folder.
@@ -193,7 +197,7 @@ pub fn face_paths(dir: &Path) -> Result<[PathBuf; 6]> {
                         return Err(Error::file(&p, "is a symbolic link to nothing"));
                     }
                 }
-                Err(e) => return Err(Error::file(&p, format!("cannot read: {e}"))),
+                Err(e) => return Err(Error::file_caused(&p, "cannot read", e)),
             }
         }
         match found.len() {
@@ -263,8 +267,8 @@ enum Kind {
 fn kind(path: &Path) -> Result<Kind> {
     use std::io::Read;
     let mut head = [0u8; 4];
-    let mut f = std::fs::File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let n = f.read(&mut head).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let mut f = std::fs::File::open(path).map_err(|e| Error::file_caused(path, "cannot read", e))?;
+    let n = f.read(&mut head).map_err(|e| Error::file_caused(path, "cannot read", e))?;
     match &head[..n] {
         [0x76, 0x2f, 0x31, 0x01] => Ok(Kind::Exr),
         [b'#', b'?', ..] => Ok(Kind::Hdr),
@@ -274,32 +278,36 @@ fn kind(path: &Path) -> Result<Kind> {
 }
 
 fn file_len(path: &Path) -> Result<u64> {
-    std::fs::metadata(path).map(|m| m.len()).map_err(|e| Error::file(path, format!("cannot read: {e}")))
+    std::fs::metadata(path).map(|m| m.len()).map_err(|e| Error::file_caused(path, "cannot read", e))
 }
 
-/// Width and height of an `.hdr` or `.exr` image, from its header alone, checked against
-/// the file's size: a header that promises more blocks or scanlines than the file can hold
-/// is refused here, before anything is allocated for them.
-pub fn dimensions(path: &Path) -> Result<(u32, u32)> {
-    match kind(path)? {
-        Kind::Exr => Ok(exr_header(path, &mut buffered(path)?, file_len(path)?)?.size),
-        Kind::Hdr => {
-            let (w, h) = rgbe::header(path, &mut buffered(path)?)?;
-            check_side(path, w, h)?;
-            check_hdr_length(path, h, file_len(path)?)?;
-            Ok((w, h))
+internal! {
+    /// Width and height of an `.hdr` or `.exr` image, from its header alone, checked against
+    /// the file's size: a header that promises more blocks or scanlines than the file can hold
+    /// is refused here, before anything is allocated for them.
+    pub fn dimensions(path: &Path) -> Result<(u32, u32)> {
+        match kind(path)? {
+            Kind::Exr => Ok(exr_header(path, &mut buffered(path)?, file_len(path)?)?.size),
+            Kind::Hdr => {
+                let (w, h) = rgbe::header(path, &mut buffered(path)?)?;
+                check_side(path, w, h)?;
+                check_hdr_length(path, h, file_len(path)?)?;
+                Ok((w, h))
+            }
         }
     }
 }
 
 fn buffered(path: &Path) -> Result<std::io::BufReader<std::fs::File>> {
-    Ok(std::io::BufReader::new(std::fs::File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?))
+    Ok(std::io::BufReader::new(std::fs::File::open(path).map_err(|e| Error::file_caused(path, "cannot read", e))?))
 }
 
-/// Reads an `.hdr` or `.exr` equirect as RGBA f32 (alpha 1), row 0 at the top, reduced by
-/// `factor` (area-weighted, as it is decoded) and cleaned ([`clean`]'s rules).
-pub fn read_reduced(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
-    read_with(path, Weights::EquirectRows, sanitize, factor)
+internal! {
+    /// Reads an `.hdr` or `.exr` equirect as RGBA f32 (alpha 1), row 0 at the top, reduced by
+    /// `factor` (area-weighted, as it is decoded) and cleaned ([`clean`]'s rules).
+    pub fn read_reduced(path: &Path, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
+        read_with(path, Weights::EquirectRows, sanitize, factor)
+    }
 }
 
 /// Reads an `.hdr` or `.exr` image reduced by `factor`, its texels weighted by `weights`.
@@ -320,16 +328,18 @@ fn check_side(path: &Path, w: u32, h: u32) -> Result<()> {
     Ok(())
 }
 
-/// Counts and fixes negative values, and refuses or sanitises NaN and ∞ (see the module
-/// documentation), in place. Alpha is set to 1.
-pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputReport> {
-    let mut reducer = Reducer::new(texels.len() as u32, 1, 1, Weights::EquirectRows, sanitize);
-    for (i, t) in texels.iter().enumerate() {
-        reducer.push(i as u32, 0, [t.x, t.y, t.z]);
+internal! {
+    /// Counts and fixes negative values, and refuses or sanitises NaN and ∞ (see the module
+    /// documentation), in place. Alpha is set to 1.
+    pub fn clean(path: &Path, texels: &mut [Vec4], sanitize: bool) -> Result<InputReport> {
+        let mut reducer = Reducer::new(texels.len() as u32, 1, 1, Weights::EquirectRows, sanitize);
+        for (i, t) in texels.iter().enumerate() {
+            reducer.push(i as u32, 0, [t.x, t.y, t.z]);
+        }
+        let (image, report) = reducer.finish(path)?;
+        texels.copy_from_slice(&image.texels);
+        Ok(report)
     }
-    let (image, report) = reducer.finish(path)?;
-    texels.copy_from_slice(&image.texels);
-    Ok(report)
 }
 
 /// The environment `runner` shows when given none: Greg Zaal's "courtyard" (CC0, see
@@ -345,24 +355,26 @@ pub fn embedded_default() -> Result<Environment> {
     Ok(Environment::Equirect(image))
 }
 
-/// What identifies an environment for the bake cache: the BLAKE3 hash of the file's bytes,
-/// of a face folder's six files in order, or of the embedded default, read in a stream.
-pub fn identity(path: Option<&Path>) -> Result<[u8; 32]> {
-    let mut h = blake3::Hasher::new();
-    match path {
-        #[cfg(feature = "embedded-environment")]
-        None => {
-            h.update(EMBEDDED_DEFAULT);
-        }
-        #[cfg(not(feature = "embedded-environment"))]
-        None => return Err(Error::Invalid("no environment given, and splitsum was built without the embedded default (feature embedded-environment)".into())),
-        Some(p) => {
-            let files = if p.is_dir() { face_paths(p)?.to_vec() } else { vec![p.to_path_buf()] };
-            for f in files {
-                let file = std::fs::File::open(&f).map_err(|e| Error::file(&f, format!("cannot read: {e}")))?;
-                h.update_reader(file).map_err(|e| Error::file(&f, format!("cannot read: {e}")))?;
+internal! {
+    /// What identifies an environment for the bake cache: the BLAKE3 hash of the file's bytes,
+    /// of a face folder's six files in order, or of the embedded default, read in a stream.
+    pub fn identity(path: Option<&Path>) -> Result<[u8; 32]> {
+        let mut h = blake3::Hasher::new();
+        match path {
+            #[cfg(feature = "embedded-environment")]
+            None => {
+                h.update(EMBEDDED_DEFAULT);
+            }
+            #[cfg(not(feature = "embedded-environment"))]
+            None => return Err(Error::Invalid("no environment given, and splitsum was built without the embedded default (feature embedded-environment)".into())),
+            Some(p) => {
+                let files = if p.is_dir() { face_paths(p)?.to_vec() } else { vec![p.to_path_buf()] };
+                for f in files {
+                    let file = std::fs::File::open(&f).map_err(|e| Error::file_caused(&f, "cannot read", e))?;
+                    h.update_reader(file).map_err(|e| Error::file_caused(&f, "cannot read", e))?;
+                }
             }
         }
+        Ok(*h.finalize().as_bytes())
     }
-    Ok(*h.finalize().as_bytes())
 }

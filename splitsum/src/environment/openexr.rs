@@ -63,7 +63,7 @@ pub(super) fn exr_header<R: std::io::BufRead + std::io::Seek>(path: &Path, reade
         && (x1 < x0 || y1 < y0) {
             return Err(malformed(format!("its data window is inverted (from ({x0}, {y0}) to ({x1}, {y1}))")));
         }
-    reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file_caused(path, "cannot read", e))?;
     let meta = exr::meta::MetaData::read_from_buffered(reader, false).map_err(|e| exr_error(path, e))?;
     let header = meta.headers.iter().find(|h| !h.deep && exr_channels(h).is_some()).ok_or_else(|| {
         let names: Vec<String> = meta.headers.iter().flat_map(|h| h.channels.list.iter().map(|c| c.name.to_string())).collect();
@@ -127,7 +127,7 @@ pub(super) fn read_exr<R: std::io::BufRead + std::io::Seek>(
 ) -> Result<(Equirect, InputReport)> {
     use exr::prelude::{ReadChannels, ReadLayers, ReadSpecificChannel};
     let header = exr_header(path, &mut reader, len)?;
-    reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file_caused(path, "cannot read", e))?;
     let (w, h) = header.size;
     let new = |size: exr::math::Vec2<usize>| (size.width() == w as usize && size.height() == h as usize).then(|| Reducer::new(w, h, factor, weights, sanitize));
     let pixels = match header.channels {

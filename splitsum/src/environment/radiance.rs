@@ -25,7 +25,7 @@ pub(super) fn read_hdr(path: &Path, weights: Weights, sanitize: bool, factor: u3
     for y in 0..h {
         rgbe::scanline(&mut r, &mut line).map_err(|e| match e.kind() {
             std::io::ErrorKind::UnexpectedEof => Error::file(path, format!("truncated Radiance HDR: the file ends in scanline {y} of {h}")),
-            _ => Error::file(path, format!("malformed Radiance HDR in scanline {y} of {h}: {e}")),
+            _ => Error::file_caused(path, format!("malformed Radiance HDR in scanline {y} of {h}"), e),
         })?;
         for (x, p) in line.iter().enumerate() {
             reducer.push(x as u32, y, rgbe::to_f32(*p));

@@ -124,7 +124,7 @@ impl OutputDir {
     /// entry that appeared, or a file that changed, between the check and the swap), that
     /// folder is kept beside the new one and a note says where.
     pub fn commit(mut self) -> Result<()> {
-        let manifest = manifest_of(&self.staging).map_err(|e| Error::file(&self.target, format!("cannot list the output files: {e}")))?;
+        let manifest = manifest_of(&self.staging).map_err(|e| Error::file_caused(&self.target, "cannot list the output files", e))?;
         write_atomic(&self.staging.join(OUTPUT_MANIFEST), |w| w.write_all(&manifest.to_json()))?;
         let pending = PENDING.lock().unwrap_or_else(|e| e.into_inner());
         let old: Option<Verified> = match std::fs::symlink_metadata(&self.target) {
@@ -134,7 +134,7 @@ impl OutputDir {
         };
         sync_dir(&self.staging);
         let swapped = if old.is_some() { exchange(&self.staging, &self.target) } else { std::fs::rename(&self.staging, &self.target) };
-        swapped.map_err(|e| Error::file(&self.target, format!("could not replace the output folder: {e}")))?;
+        swapped.map_err(|e| Error::file_caused(&self.target, "could not replace the output folder", e))?;
         sync_dir(&parent_dir(&self.target));
         self.committed = true;
         // The staging path now holds the old folder, which `old`'s handle follows.

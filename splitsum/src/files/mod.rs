@@ -27,11 +27,11 @@ pub fn check_writable(path: &Path) -> Result<()> {
     match std::fs::metadata(&dir) {
         Ok(m) if m.is_dir() => {}
         Ok(_) => return Err(Error::file(path, format!("cannot write here: {} is a file, not a folder", dir.display()))),
-        Err(e) => return Err(Error::file(path, format!("cannot write here: folder {}: {e}", dir.display()))),
+        Err(e) => return Err(Error::file_caused(path, format!("cannot write here: folder {}", dir.display()), e)),
     }
     // Probe with a temporary file of a name nobody has (created new, never opened if it
     // exists): permissions and read-only file systems show up now, not after a long bake.
-    let (probe, _) = create_new_sibling(&dir.join(".splitsum-probe")).map_err(|e| Error::file(path, format!("cannot write here: {e}")))?;
+    let (probe, _) = create_new_sibling(&dir.join(".splitsum-probe")).map_err(|e| Error::file_caused(path, "cannot write here", e))?;
     let _ = std::fs::remove_file(&probe);
     Ok(())
 }
@@ -41,8 +41,8 @@ pub fn check_writable(path: &Path) -> Result<()> {
 /// make a reader hold more than `max`.
 pub fn read_text(path: &Path, max: u64) -> Result<String> {
     use std::io::Read;
-    let file = File::open(path).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
-    let meta = file.metadata().map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    let file = File::open(path).map_err(|e| Error::file_caused(path, "cannot read", e))?;
+    let meta = file.metadata().map_err(|e| Error::file_caused(path, "cannot read", e))?;
     if !meta.is_file() {
         return Err(Error::file(path, "is not a regular file"));
     }
@@ -50,7 +50,7 @@ pub fn read_text(path: &Path, max: u64) -> Result<String> {
         return Err(Error::file(path, format!("is {} bytes; a file of this kind has at most {max}", meta.len())));
     }
     let mut text = String::new();
-    file.take(max).read_to_string(&mut text).map_err(|e| Error::file(path, format!("cannot read: {e}")))?;
+    file.take(max).read_to_string(&mut text).map_err(|e| Error::file_caused(path, "cannot read", e))?;
     Ok(text)
 }
 
@@ -133,7 +133,7 @@ pub fn check_output_file(path: &Path, kind: FileKind, called: &str) -> Result<()
         Ok(m) if !m.is_file() => return Err(Error::Invalid(format!("{called} {shown} exists and is not a regular file; name another file"))),
         Ok(_) => {
             let mut head = [0u8; 8];
-            let n = std::fs::File::open(path).and_then(|mut f| std::io::Read::read(&mut f, &mut head)).map_err(|e| Error::file(path, format!("cannot read the existing file: {e}")))?;
+            let n = std::fs::File::open(path).and_then(|mut f| std::io::Read::read(&mut f, &mut head)).map_err(|e| Error::file_caused(path, "cannot read the existing file", e))?;
             let found = FileKind::of_signature(&head[..n]);
             if found != Some(kind) {
                 let what = found.map_or_else(|| "not".to_string(), |k| format!("an {} file, not", k.name()));
@@ -196,7 +196,7 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> std
         if let Some(t) = &tmp {
             let _ = std::fs::remove_file(t);
         }
-        Error::file(path, format!("could not write: {e}"))
+        Error::file_caused(path, "could not write", e)
     })
 }
 
@@ -205,7 +205,7 @@ pub fn write_atomic(path: &Path, write: impl FnOnce(&mut BufWriter<File>) -> std
 /// made again.
 pub fn create_folder(dir: &Path) -> Result<()> {
     let _interrupt = PENDING.lock().unwrap_or_else(|e| e.into_inner());
-    std::fs::create_dir_all(dir).map_err(|e| Error::file(dir, format!("cannot create the output folder: {e}")))
+    std::fs::create_dir_all(dir).map_err(|e| Error::file_caused(dir, "cannot create the output folder", e))
 }
 
 /// Writes the BRDF table as a two-channel (R = scale, G = bias) 32-bit float OpenEXR.
@@ -218,7 +218,7 @@ pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
     });
     let image = Image::from_channels((size, size), pixels);
     let mut buf = std::io::Cursor::new(Vec::new());
-    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file(path, format!("could not encode: {e}")))?;
+    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file_caused(path, "could not encode", e))?;
     write_atomic(path, |w| w.write_all(buf.get_ref()))
 }
 
@@ -275,7 +275,7 @@ pub fn write_rgb_exr(path: &Path, width: u32, height: u32, pixels: &[splitsum_sh
     );
     let image = Image::from_layer(layer);
     let mut buf = std::io::Cursor::new(Vec::new());
-    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file(path, format!("could not encode: {e}")))?;
+    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file_caused(path, "could not encode", e))?;
     write_atomic(path, |w| w.write_all(buf.get_ref()))
 }
 

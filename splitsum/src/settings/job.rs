@@ -88,12 +88,12 @@ pub struct Job {
     pub sheen_levels: Vec<u32>,
     /// Roughness of each specular mip.
     pub roughness_per_mip: Vec<f32>,
-    /// Sheen roughness of each mip of the sheen cube ([`SHEEN_MAPPING`]; it has the
+    /// Sheen roughness of each mip of the sheen cube (linear: `settings::SHEEN_MAPPING`; it has the
     /// specular cube's size and mips).
     pub sheen_roughness_per_mip: Vec<f32>,
     /// The source level each sheen mip is summed over exactly, or `prefilter::SAMPLED`.
     pub sheen_exact_levels: Vec<u32>,
-    /// GGX samples per texel of each specular mip (capped at [`MAX_SAMPLES`]).
+    /// GGX samples per texel of each specular mip (capped at 2²⁰).
     pub samples_per_mip: Vec<u32>,
     /// The source level each mip is summed over exactly, or `prefilter::SAMPLED`.
     pub exact_levels: Vec<u32>,
@@ -204,8 +204,8 @@ impl Job {
         }
     }
 
-    /// What this bake changes from what its settings ask: a mip's sample count capped at
-    /// [`MAX_SAMPLES`], a source cube finer than the environment resolves.
+    /// What this bake changes from what its settings ask: a mip's sample count capped at 2²⁰ (`MAX_SAMPLES`),
+    /// a source cube finer than the environment resolves.
     pub fn adjustments(&self) -> Vec<Adjustment> {
         let mut out = Vec::new();
         for (mip, asked) in self.asked_samples_per_mip().into_iter().enumerate() {

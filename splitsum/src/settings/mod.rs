@@ -336,7 +336,7 @@ pub enum Unread {
 }
 
 impl Unread {
-    /// Why, naming settings through `term` (as [`Adjustment::describe`]) and the target.
+    /// Why, naming settings through `term` (as [`Adjustment::describe`](crate::adjustment::Adjustment::describe)) and the target.
     pub fn describe(self, target: Target, term: &dyn Fn(Field) -> String) -> String {
         let by = |what: &str| if target == Target::Splitsum { format!("this bake makes no {what}") } else { format!("the {} target makes no {what}", target.name()) };
         match self {

@@ -119,9 +119,9 @@ pub async fn map_read_async(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Res
     let sender = done.clone();
     buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| sender.send(r));
     // Drives the mapping on native backends; nothing to drive in a browser.
-    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
-    done.await.map_err(|e| Error::Gpu(format!("readback: {e}")))?;
-    let bytes = buffer.slice(..).get_mapped_range().map_err(|e| Error::Gpu(format!("readback: {e}")))?.to_vec();
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::gpu_caused("waiting for the device", e))?;
+    done.await.map_err(|e| Error::gpu_caused("readback", e))?;
+    let bytes = buffer.slice(..).get_mapped_range().map_err(|e| Error::gpu_caused("readback", e))?.to_vec();
     buffer.unmap();
     Ok(bytes)
 }

@@ -170,49 +170,55 @@ impl Gpu {
         Self::matching(backends_from_env(), std::env::var("WGPU_ADAPTER_NAME").ok().as_deref())
     }
 
-    /// Opens the best adapter as [`Gpu::new`] does, unless it is a software rasteriser on
-    /// the CPU (`wgpu::DeviceType::Cpu`: lavapipe, llvmpipe, SwiftShader, WARP): then, or
-    /// where there is no adapter, nothing is opened and the adapter passed over is returned.
-    pub fn unless_software() -> Result<std::result::Result<Self, Option<wgpu::AdapterInfo>>> {
-        let backends = backends_from_env();
-        let instance = instance(backends);
-        let filter = std::env::var("WGPU_ADAPTER_NAME").ok();
-        let Some(adapter) = adapters(&instance, backends, filter.as_deref()).into_iter().next() else { return Ok(Err(None)) };
-        let info = adapter.get_info();
-        if info.device_type == wgpu::DeviceType::Cpu {
-            return Ok(Err(Some(info)));
+    internal! {
+        /// Opens the best adapter as [`Gpu::new`] does, unless it is a software rasteriser on
+        /// the CPU (`wgpu::DeviceType::Cpu`: lavapipe, llvmpipe, SwiftShader, WARP): then, or
+        /// where there is no adapter, nothing is opened and the adapter passed over is returned.
+        pub fn unless_software() -> Result<std::result::Result<Self, Option<wgpu::AdapterInfo>>> {
+            let backends = backends_from_env();
+            let instance = instance(backends);
+            let filter = std::env::var("WGPU_ADAPTER_NAME").ok();
+            let Some(adapter) = adapters(&instance, backends, filter.as_deref()).into_iter().next() else { return Ok(Err(None)) };
+            let info = adapter.get_info();
+            if info.device_type == wgpu::DeviceType::Cpu {
+                return Ok(Err(Some(info)));
+            }
+            Self::with_adapter(instance, adapter).map(Ok)
         }
-        Self::with_adapter(instance, adapter).map(Ok)
     }
 
-    /// Opens the best adapter on `backends` whose name contains `filter` (any, if `None`).
-    pub fn matching(backends: wgpu::Backends, filter: Option<&str>) -> Result<Self> {
-        let instance = instance(backends);
-        let adapter = adapters(&instance, backends, filter).into_iter().next().ok_or_else(|| Error::NoAdapter {
-            detail: match (filter, backends == wgpu::Backends::all()) {
-                (Some(want), true) => format!(" whose name contains {want:?} (WGPU_ADAPTER_NAME)"),
-                (Some(want), false) => format!(" on {backends:?} (WGPU_BACKEND) whose name contains {want:?} (WGPU_ADAPTER_NAME)"),
-                (None, true) => String::new(),
-                (None, false) => format!(" on {backends:?} (WGPU_BACKEND)"),
-            },
-        })?;
-        Self::with_adapter(instance, adapter)
+    internal! {
+        /// Opens the best adapter on `backends` whose name contains `filter` (any, if `None`).
+        pub fn matching(backends: wgpu::Backends, filter: Option<&str>) -> Result<Self> {
+            let instance = instance(backends);
+            let adapter = adapters(&instance, backends, filter).into_iter().next().ok_or_else(|| Error::NoAdapter {
+                detail: match (filter, backends == wgpu::Backends::all()) {
+                    (Some(want), true) => format!(" whose name contains {want:?} (WGPU_ADAPTER_NAME)"),
+                    (Some(want), false) => format!(" on {backends:?} (WGPU_BACKEND) whose name contains {want:?} (WGPU_ADAPTER_NAME)"),
+                    (None, true) => String::new(),
+                    (None, false) => format!(" on {backends:?} (WGPU_BACKEND)"),
+                },
+            })?;
+            Self::with_adapter(instance, adapter)
+        }
     }
 
-    /// Builds the device and pipelines on `adapter` of `instance`.
-    pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
-        let info = adapter.get_info();
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("splitsum"),
-            required_features: wgpu::Features::empty(),
-            required_limits: adapter.limits(),
-            ..Default::default()
-        }))
-        .map_err(|e| Error::Gpu(format!("could not open {}: {e}", info.name)))?;
-        let mut gpu = Self::on_device(&device, &queue)?;
-        gpu.instance = Some(instance);
-        gpu.adapter = Some(adapter);
-        Ok(gpu)
+    internal! {
+        /// Builds the device and pipelines on `adapter` of `instance`.
+        pub fn with_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self> {
+            let info = adapter.get_info();
+            let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("splitsum"),
+                required_features: wgpu::Features::empty(),
+                required_limits: adapter.limits(),
+                ..Default::default()
+            }))
+            .map_err(|e| Error::gpu_caused(format!("could not open {}", info.name), e))?;
+            let mut gpu = Self::on_device(&device, &queue)?;
+            gpu.instance = Some(instance);
+            gpu.adapter = Some(adapter);
+            Ok(gpu)
+        }
     }
 
     /// The kernels' pipelines on a device the caller opened (wgpu handles are shared, so
@@ -230,8 +236,9 @@ impl Gpu {
             label: Some("splitsum-shaders"),
             source: wgpu::ShaderSource::SpirV(Cow::Borrowed(splitsum_spirv::words())),
         });
+        // As text: `wgpu::Error` is not `Send` in a browser.
         if let Some(e) = scope.pop().await {
-            return Err(Error::Gpu(format!("the shader module did not validate on {}: {e}", info.name)));
+            return Err(Error::gpu_caused(format!("the shader module did not validate on {}", info.name), e.to_string()));
         }
         // Each pipeline checked in an error scope of its own, so that an error names its
         // kernel. The cube reader binds a texture of the caller's format: built when needed.
@@ -268,7 +275,7 @@ impl Gpu {
         };
         for (name, pipeline, layout, error) in built {
             if let Some(e) = error {
-                return Err(Error::Gpu(format!("kernel {name} did not validate on {}: {e}", info.name)));
+                return Err(Error::gpu_caused(format!("kernel {name} did not validate on {}", info.name), e.to_string()));
             }
             pipelines.insert(name, (pipeline, layout));
         }
@@ -292,95 +299,107 @@ impl Gpu {
         self.info.device_type == wgpu::DeviceType::Cpu
     }
 
-    /// A storage buffer holding `data`.
-    pub fn upload_bytes(&self, label: &str, data: &[u8]) -> wgpu::Buffer {
-        filled(&self.device, &self.queue, label, data, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST)
-    }
-
-    /// The largest buffer this device binds as one storage buffer.
-    pub fn max_binding(&self) -> u64 {
-        let limits = self.device.limits();
-        limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
-    }
-
-    /// An output storage buffer of `bytes` bytes, checked against the device's limits.
-    pub fn output(&self, label: &str, bytes: u64) -> Result<wgpu::Buffer> {
-        let max = self.max_binding();
-        if bytes > max {
-            return Err(Error::Gpu(format!(
-                "{label} needs {bytes} bytes, more than this device binds in one buffer ({max}); use a smaller size or the CPU backend"
-            )));
-        }
-        Ok(self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size: bytes.max(16),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        }))
-    }
-
-    /// Records `dispatches` in order into `encoder`.
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, dispatches: &[Dispatch<'_>]) {
-        // A uniform block's size is its struct's, rounded up to 16 bytes as uniform
-        // layout rounds it: the parameter structs carry no padding fields.
-        let params: Vec<wgpu::Buffer> = dispatches
-            .iter()
-            .map(|d| {
-                let mut bytes = d.params.to_vec();
-                bytes.resize(bytes.len().next_multiple_of(16).max(16), 0);
-                filled(&self.device, &self.queue, "params", &bytes, wgpu::BufferUsages::UNIFORM)
-            })
-            .collect();
-        let groups: Vec<wgpu::BindGroup> = dispatches
-            .iter()
-            .zip(&params)
-            .map(|(d, p)| {
-                let entries: Vec<wgpu::BindGroupEntry> = d
-                    .kernel
-                    .bindings
-                    .iter()
-                    .map(|b| {
-                        let buffer = match b.resource {
-                            Resource::Uniform => p,
-                            Resource::Storage { read_only: true } => d.input.unwrap_or(&self.empty),
-                            Resource::Storage { read_only: false } => d.output,
-                            r => unreachable!("kernel {} binds a {r:?}", d.kernel.name),
-                        };
-                        wgpu::BindGroupEntry { binding: b.binding, resource: buffer.as_entire_binding() }
-                    })
-                    .collect();
-                self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &self.pipelines[d.kernel.name].1, entries: &entries })
-            })
-            .collect();
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: None });
-        for (d, g) in dispatches.iter().zip(&groups) {
-            let [x, y, z] = d.kernel.workgroups(d.invocations);
-            pass.set_pipeline(&self.pipelines[d.kernel.name].0);
-            pass.set_bind_group(0, g, &[]);
-            pass.dispatch_workgroups(x, y, z);
+    internal! {
+        /// A storage buffer holding `data`.
+        pub fn upload_bytes(&self, label: &str, data: &[u8]) -> wgpu::Buffer {
+            filled(&self.device, &self.queue, label, data, wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST)
         }
     }
 
-    /// Records and submits `dispatches` in order, in one submission.
-    pub fn run(&self, dispatches: &[Dispatch<'_>]) {
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        self.record(&mut encoder, dispatches);
-        self.queue.submit([encoder.finish()]);
+    internal! {
+        /// The largest buffer this device binds as one storage buffer.
+        pub fn max_binding(&self) -> u64 {
+            let limits = self.device.limits();
+            limits.max_storage_buffer_binding_size.min(limits.max_buffer_size)
+        }
     }
 
-    /// Waits for the queue and copies `buffer` back.
-    pub fn read_bytes(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
-        let size = buffer.size();
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
-        self.queue.submit([encoder.finish()]);
-        map_read(&self.device, &staging)
+    internal! {
+        /// An output storage buffer of `bytes` bytes, checked against the device's limits.
+        pub fn output(&self, label: &str, bytes: u64) -> Result<wgpu::Buffer> {
+            let max = self.max_binding();
+            if bytes > max {
+                return Err(Error::gpu(format!(
+                    "{label} needs {bytes} bytes, more than this device binds in one buffer ({max}); use a smaller size or the CPU backend"
+                )));
+            }
+            Ok(self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(16),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }))
+        }
+    }
+
+    internal! {
+        /// Records `dispatches` in order into `encoder`.
+        pub fn record(&self, encoder: &mut wgpu::CommandEncoder, dispatches: &[Dispatch<'_>]) {
+            // A uniform block's size is its struct's, rounded up to 16 bytes as uniform
+            // layout rounds it: the parameter structs carry no padding fields.
+            let params: Vec<wgpu::Buffer> = dispatches
+                .iter()
+                .map(|d| {
+                    let mut bytes = d.params.to_vec();
+                    bytes.resize(bytes.len().next_multiple_of(16).max(16), 0);
+                    filled(&self.device, &self.queue, "params", &bytes, wgpu::BufferUsages::UNIFORM)
+                })
+                .collect();
+            let groups: Vec<wgpu::BindGroup> = dispatches
+                .iter()
+                .zip(&params)
+                .map(|(d, p)| {
+                    let entries: Vec<wgpu::BindGroupEntry> = d
+                        .kernel
+                        .bindings
+                        .iter()
+                        .map(|b| {
+                            let buffer = match b.resource {
+                                Resource::Uniform => p,
+                                Resource::Storage { read_only: true } => d.input.unwrap_or(&self.empty),
+                                Resource::Storage { read_only: false } => d.output,
+                                r => unreachable!("kernel {} binds a {r:?}", d.kernel.name),
+                            };
+                            wgpu::BindGroupEntry { binding: b.binding, resource: buffer.as_entire_binding() }
+                        })
+                        .collect();
+                    self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &self.pipelines[d.kernel.name].1, entries: &entries })
+                })
+                .collect();
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: None });
+            for (d, g) in dispatches.iter().zip(&groups) {
+                let [x, y, z] = d.kernel.workgroups(d.invocations);
+                pass.set_pipeline(&self.pipelines[d.kernel.name].0);
+                pass.set_bind_group(0, g, &[]);
+                pass.dispatch_workgroups(x, y, z);
+            }
+        }
+    }
+
+    internal! {
+        /// Records and submits `dispatches` in order, in one submission.
+        pub fn run(&self, dispatches: &[Dispatch<'_>]) {
+            let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            self.record(&mut encoder, dispatches);
+            self.queue.submit([encoder.finish()]);
+        }
+    }
+
+    internal! {
+        /// Waits for the queue and copies `buffer` back.
+        pub fn read_bytes(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+            let size = buffer.size();
+            let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("readback"),
+                size,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            });
+            let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+            self.queue.submit([encoder.finish()]);
+            map_read(&self.device, &staging)
+        }
     }
 }
 
@@ -413,7 +432,7 @@ fn check_limits(info: &wgpu::AdapterInfo, l: &wgpu::Limits) -> Result<()> {
     if missing.is_empty() {
         return Ok(());
     }
-    Err(Error::Gpu(format!(
+    Err(Error::gpu(format!(
         "{} ({}) cannot run splitsum's kernels: it lacks {}; bake on the CPU instead (Compute::Cpu)",
         info.name,
         api_name(info.backend),

@@ -85,35 +85,37 @@ impl Gpu {
         }]);
     }
 
-    /// The source cube (faces of `size`, full mip chain) from the `w`×`h` equirect in level
-    /// 0 of `pyramid` (a buffer of `equirect::pyramid_len` texels): its row pyramid, then
-    /// `supersample`² points per cube texel.
-    pub fn pyramid_to_cube(&self, pyramid: &wgpu::Buffer, w: u32, h: u32, size: u32, supersample: u32, facing: Facing) -> Result<Texels> {
-        let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
-        let levels = equirect::pyramid_levels(w);
-        let base = EquirectParams { width: w, height: h, face_size: size, supersample, levels, level: 0, facing: facing.code() };
-        let params: Vec<EquirectParams> = (1..levels).map(|level| EquirectParams { level, ..base }).collect();
-        let dispatches: Vec<Dispatch> = params
-            .iter()
-            .map(|p| Dispatch {
-                kernel: &spirv::KERNELS_EQUIRECT_PYRAMID,
-                params: bytemuck::bytes_of(p),
-                input: None,
-                output: pyramid,
-                invocations: [w >> p.level, h, 1],
-            })
-            .collect();
-        self.run(&dispatches);
-        let out = self.texels("source cube", layout.texel_count())?;
-        self.run(&[Dispatch {
-            kernel: &spirv::KERNELS_EQUIRECT_TO_CUBE,
-            params: bytemuck::bytes_of(&base),
-            input: Some(pyramid),
-            output: &out.buffer,
-            invocations: [size, size, FACES],
-        }]);
-        self.mips(&out.buffer, layout);
-        Ok(out)
+    internal! {
+        /// The source cube (faces of `size`, full mip chain) from the `w`×`h` equirect in level
+        /// 0 of `pyramid` (a buffer of `equirect::pyramid_len` texels): its row pyramid, then
+        /// `supersample`² points per cube texel.
+        pub fn pyramid_to_cube(&self, pyramid: &wgpu::Buffer, w: u32, h: u32, size: u32, supersample: u32, facing: Facing) -> Result<Texels> {
+            let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
+            let levels = equirect::pyramid_levels(w);
+            let base = EquirectParams { width: w, height: h, face_size: size, supersample, levels, level: 0, facing: facing.code() };
+            let params: Vec<EquirectParams> = (1..levels).map(|level| EquirectParams { level, ..base }).collect();
+            let dispatches: Vec<Dispatch> = params
+                .iter()
+                .map(|p| Dispatch {
+                    kernel: &spirv::KERNELS_EQUIRECT_PYRAMID,
+                    params: bytemuck::bytes_of(p),
+                    input: None,
+                    output: pyramid,
+                    invocations: [w >> p.level, h, 1],
+                })
+                .collect();
+            self.run(&dispatches);
+            let out = self.texels("source cube", layout.texel_count())?;
+            self.run(&[Dispatch {
+                kernel: &spirv::KERNELS_EQUIRECT_TO_CUBE,
+                params: bytemuck::bytes_of(&base),
+                input: Some(pyramid),
+                output: &out.buffer,
+                invocations: [size, size, FACES],
+            }]);
+            self.mips(&out.buffer, layout);
+            Ok(out)
+        }
     }
 
     fn mips(&self, cube: &wgpu::Buffer, layout: CubeLayout) {
@@ -131,10 +133,12 @@ impl Gpu {
 }
 
 impl Gpu {
-    /// `texels` back in host memory.
-    pub fn read_texels(&self, texels: &Texels) -> Result<Vec<Vec4>> {
-        let bytes = self.read_bytes(&texels.buffer)?;
-        Ok(bytemuck::pod_collect_to_vec(&bytes[..texels.count as usize * 16]))
+    internal! {
+        /// `texels` back in host memory.
+        pub fn read_texels(&self, texels: &Texels) -> Result<Vec<Vec4>> {
+            let bytes = self.read_bytes(&texels.buffer)?;
+            Ok(bytemuck::pod_collect_to_vec(&bytes[..texels.count as usize * 16]))
+        }
     }
 }
 
@@ -142,7 +146,7 @@ impl Kernels for Gpu {
     type Texels = Texels;
 
     fn finish(&self) -> Result<()> {
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(format!("waiting for the device: {e}")))?;
+        self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::gpu_caused("waiting for the device", e))?;
         Ok(())
     }
 
