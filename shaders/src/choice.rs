@@ -81,3 +81,58 @@ choice!(Tonemapper: Aces => "aces", Reinhard => "reinhard", Clamp => "clamp");
 choice!(DiffuseModel: Lambert => "lambert", OrenNayar => "oren-nayar", FresnelWeighted => "fresnel-weighted");
 choice!(SpecularModel: CookTorrance => "cook-torrance", Phong => "phong", BlinnPhong => "blinn-phong", None => "none");
 choice!(FresnelForm: Schlick => "schlick", SphericalGaussian => "spherical-gaussian");
+
+/// Declares a set of one-bit flags on a `u32` field of a parameter block, the other idiom
+/// that crosses between host and shader: each flag an associated constant `1 << bit` of
+/// the type, with its doc, and `FLAGS`, every flag's constant in bit order. Two flags on one
+/// bit, or a flag on a bit of the `reserved` mask (bits another field of the same word
+/// holds, as the shading ladder's fetch count), fail to compile.
+///
+/// ```
+/// # struct Options;
+/// splitsum_shaders::flags!(Options, reserved (0b1100) {
+///     /// First.
+///     FIRST = 0,
+///     /// Second.
+///     SECOND = 1,
+/// });
+/// assert_eq!((Options::FIRST, Options::SECOND), (1, 2));
+/// assert_eq!(Options::FLAGS, [1, 2]);
+/// ```
+///
+/// Two flags on one bit do not compile:
+///
+/// ```compile_fail
+/// # struct Options;
+/// splitsum_shaders::flags!(Options { A = 0, B = 0 });
+/// ```
+///
+/// Nor does a flag on a reserved bit:
+///
+/// ```compile_fail
+/// # struct Options;
+/// splitsum_shaders::flags!(Options, reserved (0b100) { A = 2 });
+/// ```
+#[macro_export]
+macro_rules! flags {
+    ($t:ty $(, reserved ($reserved:expr))? { $($(#[$meta:meta])* $name:ident = $bit:expr),* $(,)? }) => {
+        impl $t {
+            $(
+                $(#[$meta])*
+                pub const $name: u32 = 1 << $bit;
+            )*
+            /// Every flag of this set, in bit order.
+            pub const FLAGS: [u32; [$($bit),*].len()] = [$(1 << $bit),*];
+        }
+        const _: () = {
+            let flags: [u32; [$($bit),*].len()] = [$(1 << $bit),*];
+            let mut seen: u32 = 0 $(| $reserved)?;
+            let mut i = 0;
+            while i < flags.len() {
+                assert!(seen & flags[i] == 0, "two flags share a bit, or a flag takes a reserved bit");
+                seen |= flags[i];
+                i += 1;
+            }
+        };
+    };
+}

@@ -87,14 +87,14 @@ pub struct Frame {
     pub sheen_ranges: Vec4,
 }
 
-impl Frame {
+crate::flags!(Frame {
     /// Encode sRGB in the shader (the target is a UNORM format).
-    pub const ENCODE_SRGB: u32 = 1;
+    ENCODE_SRGB = 0,
     /// Draw the sphere grid.
-    pub const SPHERES: u32 = 2;
+    SPHERES = 1,
     /// Output linear radiance.
-    pub const LINEAR: u32 = 4;
-}
+    LINEAR = 2,
+});
 
 /// Spacing of the sphere grid's centres.
 pub const GRID_SPACING: f32 = 1.0;

@@ -36,22 +36,22 @@ pub struct MeshMaterial {
     pub sheen: Vec4,
 }
 
-impl MeshMaterial {
+crate::flags!(MeshMaterial {
     /// Base colour texture present.
-    pub const BASE_COLOR: u32 = 1;
+    BASE_COLOR = 0,
     /// Metallic–roughness texture present.
-    pub const METALLIC_ROUGHNESS: u32 = 2;
+    METALLIC_ROUGHNESS = 1,
     /// Normal texture present.
-    pub const NORMAL: u32 = 4;
+    NORMAL = 2,
     /// Occlusion texture present.
-    pub const OCCLUSION: u32 = 8;
+    OCCLUSION = 3,
     /// Emissive texture present.
-    pub const EMISSIVE: u32 = 16;
+    EMISSIVE = 4,
     /// Sheen colour texture present (`sheenColorTexture`, sRGB).
-    pub const SHEEN_COLOR: u32 = 32;
+    SHEEN_COLOR = 5,
     /// Sheen roughness texture present (`sheenRoughnessTexture`, alpha channel).
-    pub const SHEEN_ROUGHNESS: u32 = 64;
-}
+    SHEEN_ROUGHNESS = 6,
+});
 
 /// Texel values read at one point, one per texture slot (ignored where the slot is empty).
 #[derive(Copy, Clone, Debug, PartialEq)]

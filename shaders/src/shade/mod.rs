@@ -28,6 +28,9 @@
 //! **Sheen** (`KHR_materials_sheen`, as the glTF Sample Viewer layers it): a Charlie lobe
 //! on top, `L_o = sheen + base·(1 − max(c)·E_C)` ([`sheen_ibl`], [`sheen_direct`]).
 
+mod ladder;
+pub use ladder::{LADDER_BLEND, LADDER_FULL_BELOW, LADDER_RUNGS, MAX_FETCHES, lobe_radiance};
+
 use crate::brdf::{alpha_from_roughness, diffuse, fresnel, microfacet, phong, sheen};
 use crate::cubemap::{self, CubeLayout};
 use crate::prefilter::RoughnessMapping;
@@ -94,41 +97,44 @@ pub struct ShadeOptions {
     pub specular: u32,
     /// A [`FresnelForm`] code.
     pub fresnel: u32,
-    /// Bit 0: image-based light on; bit 1: direct lights on.
+    /// The flags of [`ShadeOptions::FLAGS`], and the ladder's fetch count in
+    /// [`ShadeOptions::FETCH_MASK`].
     pub flags: u32,
 }
 
-impl ShadeOptions {
+crate::flags!(ShadeOptions, reserved (ShadeOptions::FETCH_MASK) {
     /// Image-based light on.
-    pub const IBL: u32 = 1;
+    IBL = 0,
     /// Direct lights on.
-    pub const DIRECT: u32 = 2;
+    DIRECT = 1,
     /// Read the prefiltered cube along the specular dominant direction instead of the
     /// mirror direction ([`dominant_direction`]).
-    pub const DOMINANT_DIRECTION: u32 = 4;
+    DOMINANT_DIRECTION = 2,
     /// Multiple-scattering energy compensation of the image-based specular
     /// ([`multiple_scattering`]), for Cook–Torrance with Lambert or Oren–Nayar diffuse (the
     /// Fresnel-weighted diffuse carries its own energy split and is left as it is).
-    pub const MULTISCATTER: u32 = 8;
+    MULTISCATTER = 3,
     /// Direct lights with the exact height-correlated Smith visibility instead of
     /// Smith–Schlick (image-based light follows the table's own model).
-    pub const CORRELATED_SMITH: u32 = 16;
+    CORRELATED_SMITH = 4,
     /// Quality mode: below the roughness of mip 1, filter the mirror level at shading time
     /// ([`FIS_SAMPLES`] GGX samples, filtered importance sampling) instead of blending the
     /// mirror with mip 1.
-    pub const FILTERED_SAMPLING: u32 = 32;
+    FILTERED_SAMPLING = 5,
     /// Blend the two mips a roughness falls between in log luminance
     /// ([`cubemap::sample_lod_log`]) instead of linearly.
-    pub const LOG_MIP_BLEND: u32 = 64;
-
+    LOG_MIP_BLEND = 6,
     /// Read the BRDF table as `F₀·A + B`, its exact meaning (the table integrates Schlick's
     /// `(1 − v·h)⁵` into `B`), instead of `F·A + B` with the roughness-aware Fresnel `F` of
     /// [`fresnel_ambient`] (Fdez-Agüera 2019's form, which adds the view's Fresnel a second
     /// time at grazing views). The diffuse weight `1 − F` is the same in both.
-    pub const TABLE_F0: u32 = 128;
+    TABLE_F0 = 7,
     /// Lift the read direction of the one fetch so that the prefiltered lobe round it
     /// stays above the surface's horizon ([`above_horizon`]).
-    pub const LIFT_ABOVE_HORIZON: u32 = 1 << 11;
+    LIFT_ABOVE_HORIZON = 11,
+});
+
+impl ShadeOptions {
     /// Bits 8–10 of `flags`: log₂ of the prefiltered fetches per pixel of the shading
     /// ladder ([`lobe_radiance`]); 0 is the split sum's one fetch. Set with
     /// [`ShadeOptions::with_fetches`], read with [`ShadeOptions::fetches`].
@@ -372,104 +378,6 @@ pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: 
     } else {
         cubemap::sample_lod(specular, layout, dir, lod)
     }
-}
-
-/// Rungs of the shading ladder: 1, 2, 4, 8 and 16 fetches.
-pub const LADDER_RUNGS: u32 = 5;
-/// Most prefiltered fetches per pixel of the ladder.
-pub const MAX_FETCHES: u32 = 1 << (LADDER_RUNGS - 1);
-
-/// The radiance the specular lobe of material `m` averages, for normal `n` and view `v`:
-/// one fetch of the prefiltered cube along the read direction (the split sum), or with
-/// [`ShadeOptions::fetches`] `K > 1` the shading ladder's estimate over `K` fetches.
-///
-/// **Why.** The split sum reads radiance prefiltered with the lobe of `n = v = r`: at
-/// grazing views the true lobe is stretched, leans towards the normal and is cut by the
-/// horizon, which one fetch along one direction cannot follow (at `n·v = 0.1` that is most
-/// of the error against the full integral). The ladder spends `K` fetches to follow it.
-///
-/// **Estimator** (filtered importance sampling, Colbert & Křivánek 2007, GPU Gems 3
-/// ch. 20, over the prefiltered mips instead of the source's box-filtered ones):
-/// 1. `K` half vectors from GGX's visible normals ([`sampling::sample_vndf_tangent`]) on a
-///    Vogel spiral: radius from `(i + ½)/K`, angle `¼ + i·`[`GOLDEN`] turns (the first in
-///    the plane of incidence); `l = reflect(v, h)`. (Hammersley's angles put the outermost of
-///    four samples in that plane towards the normal, where a sun 16° off read 4.5× the rest:
-///    28 % mean error at K = 4 on the tuning set, against 12 % on the spiral.) The
-///    density of `l` is `p(l) = G₁(v) D(h) / (4 n·v)`, so the weight of a sample for
-///    `∫ f_s L (n·l) dl` is `f_s (n·l) / p(l) = F(v·h) G₂(v,l) / G₁(v)`. Samples below the
-///    horizon (`n·l ≤ 0`) weigh nothing: light from under the surface is kept out.
-/// 2. Each sample stands for a solid angle `Ω = 1 / (K p(l))`. It reads the prefiltered
-///    cube at the roughness whose own lobe covers that much sky: the prefilter's lobe
-///    (`n = v`) has peak density `D(0)/4 = 1/(4πα²)`, so it covers `4πα_f²` and
-///    `α_f² = Ω/(4π) = (n·v) q² / (K G₁(v) α²)` with `q = (n·h)²(α² − 1) + 1`
-///    (`D = α²/(π q²)`); never rougher than the material itself.
-/// 3. The samples set only the *shape* of the average: `Σ wᵢ Lᵢ / Σ wᵢ` with
-///    `wᵢ = F(v·hᵢ) V(n·v, n·lᵢ) (n·lᵢ)` (`V = G₂/(4 n·l n·v)`; the constant `4 n·v / G₁(v)`
-///    cancels). The energy still comes from the table (`F·A + B` in [`ibl`]), which is
-///    exact, so a constant sky is reproduced exactly at any `K` and the ladder only buys
-///    down the split, never adds noise to the albedo.
-/// 4. Near normal incidence the split sum's lobe is the true one and the one fetch, exact
-///    for it, beats `K` filtered samples; the estimate is blended into the one fetch between
-///    `n·v` = [`LADDER_FULL_BELOW`] and that plus [`LADDER_BLEND`] (chosen on the tuning set:
-///    at `n·v > 0.6` sixteen samples alone were 8.8 % off where one fetch is 6.5 %).
-#[inline]
-pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3) -> Vec3 {
-    let roughness = m.roughness;
-    let fetches = opts.fetches();
-    let read = opts.flags & !ShadeOptions::FILTERED_SAMPLING;
-    if fetches <= 1 || opts.specular != SpecularModel::CookTorrance as u32 {
-        return one_fetch(shape, specular, opts.flags, n, v, roughness);
-    }
-    let alpha = alpha_from_roughness(math::saturate(roughness));
-    let a2 = alpha * alpha;
-    let (t, b) = sampling::orthonormal_basis(n);
-    // The view, held above the horizon as the table holds it (n·v ≥ MIN_N_DOT_V).
-    let vt = sampling::normalize_or(Vec3::new(v.dot(t), v.dot(b), math::max(n.dot(v), MIN_N_DOT_V)), Vec3::Z);
-    let view = t * vt.x + b * vt.y + n * vt.z;
-    let nv = vt.z;
-    let one = one_fetch(shape, specular, read, n, v, roughness);
-    let s = math::saturate((LADDER_FULL_BELOW + LADDER_BLEND - nv) / LADDER_BLEND);
-    if !(s > 0.0) {
-        return one;
-    }
-    let g1 = 2.0 * nv / (nv + math::sqrt(nv * nv * (1.0 - a2) + a2));
-    let f0 = m.f0();
-    let mut sum = Vec3::ZERO;
-    let mut weights = Vec3::ZERO;
-    let mut i = 0;
-    while i < fetches {
-        let turn = 0.25 + i as f32 * GOLDEN;
-        let xi = Vec2::new((i as f32 + 0.5) / fetches as f32, turn - math::floor(turn));
-        let ht = sampling::sample_vndf_tangent(xi, alpha, vt);
-        let h = t * ht.x + b * ht.y + n * ht.z;
-        let l = sampling::reflect(view, h);
-        let nl = n.dot(l);
-        if nl > 0.0 {
-            let w = fresnel(opts.fresnel, f0, math::saturate(view.dot(h))) * (microfacet::vis_smith_correlated(nv, nl, alpha) * nl);
-            let q = ht.z * ht.z * (a2 - 1.0) + 1.0;
-            let covered = nv * q * q / (fetches as f32 * g1 * math::max(a2, 1e-12));
-            let r = math::min(math::sqrt(math::sqrt(covered)), roughness);
-            sum += w * prefiltered(shape, specular, read, l, r).truncate();
-            weights += w;
-        }
-        i += 1;
-    }
-    if !(weights.x > 0.0 && weights.y > 0.0 && weights.z > 0.0) {
-        return one;
-    }
-    one + (sum / weights - one) * s
-}
-
-/// Below this `n·v` the ladder's estimate is used alone; over the next
-/// [`LADDER_BLEND`] it is blended into the one fetch, which is used alone above.
-pub const LADDER_FULL_BELOW: f32 = 0.4;
-/// Width in `n·v` of the ladder's blend into the one fetch.
-pub const LADDER_BLEND: f32 = 0.3;
-
-/// The split sum's one fetch: the prefiltered radiance along the read direction.
-#[inline]
-fn one_fetch(shape: EnvironmentShape, specular: &[Vec4], flags: u32, n: Vec3, v: Vec3, roughness: f32) -> Vec3 {
-    prefiltered(shape, specular, flags, read_direction(flags, n, v, roughness), roughness).truncate()
 }
 
 /// The direction the one fetch reads the prefiltered cube along for normal `n` and view

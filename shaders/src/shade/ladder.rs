@@ -1,0 +1,106 @@
+//! The shading ladder: 1 to 16 fetches over the prefiltered mips by filtered importance
+//! sampling of the true GGX lobe ([`lobe_radiance`]), blended with the split sum's one
+//! fetch as `n·v` rises, for the views where one fetch cannot follow the lobe.
+
+use super::*;
+use crate::brdf::{alpha_from_roughness, microfacet};
+use crate::{math, sampling};
+use spirv_std::glam::{Vec2, Vec3, Vec4};
+
+/// Rungs of the shading ladder: 1, 2, 4, 8 and 16 fetches.
+pub const LADDER_RUNGS: u32 = 5;
+/// Most prefiltered fetches per pixel of the ladder.
+pub const MAX_FETCHES: u32 = 1 << (LADDER_RUNGS - 1);
+
+/// The radiance the specular lobe of material `m` averages, for normal `n` and view `v`:
+/// one fetch of the prefiltered cube along the read direction (the split sum), or with
+/// [`ShadeOptions::fetches`] `K > 1` the shading ladder's estimate over `K` fetches.
+///
+/// **Why.** The split sum reads radiance prefiltered with the lobe of `n = v = r`: at
+/// grazing views the true lobe is stretched, leans towards the normal and is cut by the
+/// horizon, which one fetch along one direction cannot follow (at `n·v = 0.1` that is most
+/// of the error against the full integral). The ladder spends `K` fetches to follow it.
+///
+/// **Estimator** (filtered importance sampling, Colbert & Křivánek 2007, GPU Gems 3
+/// ch. 20, over the prefiltered mips instead of the source's box-filtered ones):
+/// 1. `K` half vectors from GGX's visible normals ([`sampling::sample_vndf_tangent`]) on a
+///    Vogel spiral: radius from `(i + ½)/K`, angle `¼ + i·`[`GOLDEN`] turns (the first in
+///    the plane of incidence); `l = reflect(v, h)`. (Hammersley's angles put the outermost of
+///    four samples in that plane towards the normal, where a sun 16° off read 4.5× the rest:
+///    28 % mean error at K = 4 on the tuning set, against 12 % on the spiral.) The
+///    density of `l` is `p(l) = G₁(v) D(h) / (4 n·v)`, so the weight of a sample for
+///    `∫ f_s L (n·l) dl` is `f_s (n·l) / p(l) = F(v·h) G₂(v,l) / G₁(v)`. Samples below the
+///    horizon (`n·l ≤ 0`) weigh nothing: light from under the surface is kept out.
+/// 2. Each sample stands for a solid angle `Ω = 1 / (K p(l))`. It reads the prefiltered
+///    cube at the roughness whose own lobe covers that much sky: the prefilter's lobe
+///    (`n = v`) has peak density `D(0)/4 = 1/(4πα²)`, so it covers `4πα_f²` and
+///    `α_f² = Ω/(4π) = (n·v) q² / (K G₁(v) α²)` with `q = (n·h)²(α² − 1) + 1`
+///    (`D = α²/(π q²)`); never rougher than the material itself.
+/// 3. The samples set only the *shape* of the average: `Σ wᵢ Lᵢ / Σ wᵢ` with
+///    `wᵢ = F(v·hᵢ) V(n·v, n·lᵢ) (n·lᵢ)` (`V = G₂/(4 n·l n·v)`; the constant `4 n·v / G₁(v)`
+///    cancels). The energy still comes from the table (`F·A + B` in [`ibl`]), which is
+///    exact, so a constant sky is reproduced exactly at any `K` and the ladder only buys
+///    down the split, never adds noise to the albedo.
+/// 4. Near normal incidence the split sum's lobe is the true one and the one fetch, exact
+///    for it, beats `K` filtered samples; the estimate is blended into the one fetch between
+///    `n·v` = [`LADDER_FULL_BELOW`] and that plus [`LADDER_BLEND`] (chosen on the tuning set:
+///    at `n·v > 0.6` sixteen samples alone were 8.8 % off where one fetch is 6.5 %).
+#[inline]
+pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3) -> Vec3 {
+    let roughness = m.roughness;
+    let fetches = opts.fetches();
+    let read = opts.flags & !ShadeOptions::FILTERED_SAMPLING;
+    if fetches <= 1 || opts.specular != SpecularModel::CookTorrance as u32 {
+        return one_fetch(shape, specular, opts.flags, n, v, roughness);
+    }
+    let alpha = alpha_from_roughness(math::saturate(roughness));
+    let a2 = alpha * alpha;
+    let (t, b) = sampling::orthonormal_basis(n);
+    // The view, held above the horizon as the table holds it (n·v ≥ MIN_N_DOT_V).
+    let vt = sampling::normalize_or(Vec3::new(v.dot(t), v.dot(b), math::max(n.dot(v), MIN_N_DOT_V)), Vec3::Z);
+    let view = t * vt.x + b * vt.y + n * vt.z;
+    let nv = vt.z;
+    let one = one_fetch(shape, specular, read, n, v, roughness);
+    let s = math::saturate((LADDER_FULL_BELOW + LADDER_BLEND - nv) / LADDER_BLEND);
+    if !(s > 0.0) {
+        return one;
+    }
+    let g1 = 2.0 * nv / (nv + math::sqrt(nv * nv * (1.0 - a2) + a2));
+    let f0 = m.f0();
+    let mut sum = Vec3::ZERO;
+    let mut weights = Vec3::ZERO;
+    let mut i = 0;
+    while i < fetches {
+        let turn = 0.25 + i as f32 * GOLDEN;
+        let xi = Vec2::new((i as f32 + 0.5) / fetches as f32, turn - math::floor(turn));
+        let ht = sampling::sample_vndf_tangent(xi, alpha, vt);
+        let h = t * ht.x + b * ht.y + n * ht.z;
+        let l = sampling::reflect(view, h);
+        let nl = n.dot(l);
+        if nl > 0.0 {
+            let w = fresnel(opts.fresnel, f0, math::saturate(view.dot(h))) * (microfacet::vis_smith_correlated(nv, nl, alpha) * nl);
+            let q = ht.z * ht.z * (a2 - 1.0) + 1.0;
+            let covered = nv * q * q / (fetches as f32 * g1 * math::max(a2, 1e-12));
+            let r = math::min(math::sqrt(math::sqrt(covered)), roughness);
+            sum += w * prefiltered(shape, specular, read, l, r).truncate();
+            weights += w;
+        }
+        i += 1;
+    }
+    if !(weights.x > 0.0 && weights.y > 0.0 && weights.z > 0.0) {
+        return one;
+    }
+    one + (sum / weights - one) * s
+}
+
+/// Below this `n·v` the ladder's estimate is used alone; over the next
+/// [`LADDER_BLEND`] it is blended into the one fetch, which is used alone above.
+pub const LADDER_FULL_BELOW: f32 = 0.4;
+/// Width in `n·v` of the ladder's blend into the one fetch.
+pub const LADDER_BLEND: f32 = 0.3;
+
+/// The split sum's one fetch: the prefiltered radiance along the read direction.
+#[inline]
+fn one_fetch(shape: EnvironmentShape, specular: &[Vec4], flags: u32, n: Vec3, v: Vec3, roughness: f32) -> Vec3 {
+    prefiltered(shape, specular, flags, read_direction(flags, n, v, roughness), roughness).truncate()
+}
