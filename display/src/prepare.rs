@@ -7,17 +7,29 @@ use splitsum::bake::{BakedEnvironment, Timing, bake_job, check_duration};
 use splitsum::error::Result;
 
 /// What happened to a scene's bake.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug)]
 pub enum Outcome {
     /// Found in the cache: nothing baked.
     CacheHit,
     /// Baked (and stored, when there is a cache).
     Baked,
     /// The cache held an entry that could not be used (why); baked again.
-    Rebuilt(String),
+    Rebuilt(std::sync::Arc<splitsum::cache::Rejection>),
     /// `--force`: baked again regardless of the cache.
     Forced,
 }
+
+/// Outcomes are equal when they are the same kind; two rebuilds, when for the same rejection.
+impl PartialEq for Outcome {
+    fn eq(&self, other: &Self) -> bool {
+        match (self, other) {
+            (Outcome::Rebuilt(a), Outcome::Rebuilt(b)) => std::sync::Arc::ptr_eq(a, b),
+            _ => std::mem::discriminant(self) == std::mem::discriminant(other),
+        }
+    }
+}
+
+impl Eq for Outcome {}
 
 /// A scene's bake: the plan, the products and how they were obtained.
 pub struct SceneBake {
@@ -65,7 +77,7 @@ pub fn bake_scene(
         match c.get(&key) {
             splitsum::cache::Lookup::Hit(env) => return Ok(SceneBake { plan, env: *env, key, outcome: Outcome::CacheHit, timings: Vec::new() }),
             splitsum::cache::Lookup::Miss => {}
-            splitsum::cache::Lookup::Rejected(why) => outcome = Outcome::Rebuilt(why),
+            splitsum::cache::Lookup::Rejected(why) => outcome = Outcome::Rebuilt(std::sync::Arc::new(why)),
             splitsum::cache::Lookup::Foreign(e) => return Err(e),
         }
     }

@@ -105,6 +105,60 @@ fn remove_entry(dir: &Path) -> Result<()> {
     std::fs::remove_dir(dir).map_err(|e| Error::file_caused(dir, "cannot remove the stale cache entry", e))
 }
 
+/// Why a cache entry may not be used (rendered to words only where it is shown).
+#[derive(Debug)]
+pub enum Rejection {
+    /// Its manifest cannot be read.
+    NoManifest(Error),
+    /// Its manifest is not JSON of the cache's form.
+    MalformedManifest(serde_json::Error),
+    /// Its manifest names another key or format: another bake's entry.
+    Foreign {
+        /// The key it names.
+        key: String,
+        /// The format it names.
+        format: String,
+    },
+    /// The manifest lists no such file.
+    Unlisted(&'static str),
+    /// A file that cannot be read.
+    Unreadable(&'static str, std::io::Error),
+    /// A name that is not a regular file.
+    NotAFile(&'static str),
+    /// A file of another size than the manifest says.
+    WrongSize {
+        /// The file.
+        name: &'static str,
+        /// Its size.
+        bytes: u64,
+        /// The size the manifest lists.
+        listed: u64,
+    },
+    /// A file whose BLAKE3 hash differs from the manifest's.
+    WrongHash(&'static str),
+    /// A file that changed while it was read.
+    Changed(&'static str),
+    /// A file that does not hold what its name says (a cube, or a table).
+    NotItsProduct(&'static str),
+}
+
+impl std::fmt::Display for Rejection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Rejection::NoManifest(e) => write!(f, "no readable manifest ({e})"),
+            Rejection::MalformedManifest(e) => write!(f, "malformed manifest ({e})"),
+            Rejection::Foreign { key, format } => write!(f, "a foreign entry (its manifest names key {key} in format {format})"),
+            Rejection::Unlisted(name) => write!(f, "the manifest lists no {name}"),
+            Rejection::Unreadable(name, e) => write!(f, "{name} unreadable ({e})"),
+            Rejection::NotAFile(name) => write!(f, "{name} is not a regular file"),
+            Rejection::WrongSize { name, bytes, listed } => write!(f, "{name} is corrupt (it holds {bytes} bytes, the manifest says {listed})"),
+            Rejection::WrongHash(name) => write!(f, "{name} is corrupt (its BLAKE3 hash differs from the manifest)"),
+            Rejection::Changed(name) => write!(f, "{name} changed while it was read"),
+            Rejection::NotItsProduct(name) => write!(f, "{name} does not hold {}", if name.ends_with("lut.bin") || name.ends_with("tables.bin") { "a table" } else { "a cube" }),
+        }
+    }
+}
+
 /// What a lookup found.
 pub enum Lookup {
     /// A valid entry.
@@ -112,7 +166,7 @@ pub enum Lookup {
     /// No entry.
     Miss,
     /// An entry that may not be used, and why; it has been removed.
-    Rejected(String),
+    Rejected(Rejection),
     /// An entry that may not be used and holds files the cache did not write: left as it
     /// is, and the error says what is in the way.
     Foreign(Error),
@@ -195,44 +249,41 @@ impl Cache {
         }
     }
 
-    fn read(&self, key: &str, dir: &Path) -> std::result::Result<BakedEnvironment, String> {
+    fn read(&self, key: &str, dir: &Path) -> std::result::Result<BakedEnvironment, Rejection> {
         let manifest = dir.join("manifest.json");
-        let text = crate::files::read_text(&manifest, MAX_MANIFEST_BYTES).map_err(|e| format!("no readable manifest ({e})"))?;
-        let m: Manifest = serde_json::from_str(&text).map_err(|e| format!("malformed manifest ({e})"))?;
+        let text = crate::files::read_text(&manifest, MAX_MANIFEST_BYTES).map_err(Rejection::NoManifest)?;
+        let m: Manifest = serde_json::from_str(&text).map_err(Rejection::MalformedManifest)?;
         if m.format != FORMAT || m.key != key {
-            return Err(format!("a foreign entry (its manifest names key {} in format {})", m.key, m.format));
+            return Err(Rejection::Foreign { key: m.key, format: m.format });
         }
-        let file = |name: &str| -> std::result::Result<Vec<u8>, String> {
-            let want = m.files.get(name).ok_or_else(|| format!("the manifest lists no {name}"))?;
+        let file = |name: &'static str| -> std::result::Result<Vec<u8>, Rejection> {
+            let want = m.files.get(name).ok_or(Rejection::Unlisted(name))?;
             // The size first: a file longer than the manifest says is never read in.
-            let meta = std::fs::metadata(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?;
+            let meta = std::fs::metadata(dir.join(name)).map_err(|e| Rejection::Unreadable(name, e))?;
             if !meta.is_file() {
-                return Err(format!("{name} is not a regular file"));
+                return Err(Rejection::NotAFile(name));
             }
             let len = meta.len();
             if len != want.bytes {
-                return Err(format!("{name} is corrupt (it holds {len} bytes, the manifest says {})", want.bytes));
+                return Err(Rejection::WrongSize { name, bytes: len, listed: want.bytes });
             }
             // Then the hash, streamed: a file that is not what the manifest says is never held.
             let mut h = blake3::Hasher::new();
-            let file = std::fs::File::open(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?;
-            h.update_reader(file).map_err(|e| format!("{name} unreadable ({e})"))?;
+            let file = std::fs::File::open(dir.join(name)).map_err(|e| Rejection::Unreadable(name, e))?;
+            h.update_reader(file).map_err(|e| Rejection::Unreadable(name, e))?;
             if h.finalize().to_hex().as_str() != want.blake3 {
-                return Err(format!("{name} is corrupt (its BLAKE3 hash differs from the manifest)"));
+                return Err(Rejection::WrongHash(name));
             }
-            let bytes = std::fs::read(dir.join(name)).map_err(|e| format!("{name} unreadable ({e})"))?;
+            let bytes = std::fs::read(dir.join(name)).map_err(|e| Rejection::Unreadable(name, e))?;
             if bytes.len() as u64 != want.bytes {
-                return Err(format!("{name} changed while it was read"));
+                return Err(Rejection::Changed(name));
             }
             Ok(bytes)
         };
-        let bad = |name: &str| format!("{name} does not hold a cube");
-        let source = cube_from(&file("source.bin")?).ok_or_else(|| bad("source.bin"))?;
-        let specular = cube_from(&file("specular.bin")?).ok_or_else(|| bad("specular.bin"))?;
-        let irradiance = cube_from(&file("irradiance.bin")?).ok_or_else(|| bad("irradiance.bin"))?;
-        let lut = table_from(&file("lut.bin")?).ok_or("lut.bin does not hold a table")?;
-        let sheen = cube_from(&file("sheen.bin")?).ok_or_else(|| bad("sheen.bin"))?;
-        let sheen_tables = table_from(&file("sheen_tables.bin")?).ok_or("sheen_tables.bin does not hold a table")?;
+        let cube = |name: &'static str| cube_from(&file(name)?).ok_or(Rejection::NotItsProduct(name));
+        let table = |name: &'static str| table_from(&file(name)?).ok_or(Rejection::NotItsProduct(name));
+        let (source, specular, irradiance, lut) = (cube("source.bin")?, cube("specular.bin")?, cube("irradiance.bin")?, table("lut.bin")?);
+        let (sheen, sheen_tables) = (cube("sheen.bin")?, table("sheen_tables.bin")?);
         Ok(BakedEnvironment { source, specular, irradiance, lut, sheen, sheen_tables, mapping: RoughnessMapping::from_u32(m.mapping) })
     }
 

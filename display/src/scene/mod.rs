@@ -45,7 +45,9 @@
 //! radiance = [3.0, 3.0, 3.0]
 //! ```
 
+mod problem;
 mod spec;
+pub use problem::Problem;
 pub use spec::{CameraSpec, DisplaySpec, LightSpec, MaterialSpec, ObjectSpec, OutputSpec, Param, QualitySpec, ShadingChoices, check_fetches};
 
 use serde::{Deserialize, Serialize};
@@ -97,41 +99,37 @@ impl Scene {
     /// Reads and checks a scene file.
     pub fn load(path: &Path) -> Result<Self> {
         let text = splitsum::files::read_text(path, MAX_SCENE_BYTES)?;
-        let mut scene = Self::parse(&text).map_err(|e| match e {
-            Error::Invalid(m) => Error::Invalid(format!("{}: {m}", path.display())),
-            other => other,
-        })?;
+        let mut scene = Self::parse(&text).map_err(|e| Error::Invalid(format!("{}: {e}", path.display())))?;
         scene.dir = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok(scene)
     }
 
     /// Parses and checks scene text (paths relative to the current folder).
-    pub fn parse(text: &str) -> Result<Self> {
-        let scene: Scene = toml::from_str(text).map_err(|e| Error::Invalid(format!("not a valid scene: {e}")))?;
+    pub fn parse(text: &str) -> std::result::Result<Self, Problem> {
+        let scene: Scene = toml::from_str(text).map_err(Problem::Syntax)?;
         scene.check()?;
         Ok(scene)
     }
 
-    fn check(&self) -> Result<()> {
-        let bad = |m: String| Err(Error::Invalid(m));
+    fn check(&self) -> std::result::Result<(), Problem> {
         for m in &self.materials {
             if let Err(problem) = check_fetches(m.fetches) {
-                return bad(format!("material {:?}: fetches {problem}", m.name));
+                return Err(Problem::Fetches { material: m.name.clone(), problem });
             }
             for (what, p) in [("metallic", &m.metallic), ("roughness", &m.roughness)] {
                 if let Param::Texture(t) = p
                     && t != "texture" {
-                        return bad(format!("material {:?}: {what} must be a number, [a, b] or \"texture\", not {t:?}", m.name));
+                        return Err(Problem::NotAParameter { material: m.name.clone(), key: what, text: t.clone() });
                     }
                 let (a, b) = p.range();
                 if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a > b {
-                    return bad(format!("material {:?}: {what} range [{a}, {b}] must lie in [0, 1] with a ≤ b", m.name));
+                    return Err(Problem::Range { material: m.name.clone(), key: what, range: (a, b) });
                 }
             }
         }
         for o in &self.objects {
             if !self.materials.iter().any(|m| m.name == o.material()) {
-                return bad(format!("an object uses material {:?}, which no [[materials]] entry defines", o.material()));
+                return Err(Problem::UndefinedMaterial(o.material().to_string()));
             }
         }
         // The display draws one sphere grid and one glTF model, each with its own material;
@@ -140,28 +138,26 @@ impl Scene {
         let models = self.objects.iter().filter(|o| matches!(o, ObjectSpec::Gltf { .. })).count();
         for (n, kind) in [(grids, "sphere-grid"), (models, "gltf")] {
             if n > 1 {
-                return bad(format!(
-                    "[[objects]] lists {n} objects of kind {kind:?}; the display draws one sphere grid and one glTF model a scene, each with its own material: give the others scenes of their own"
-                ));
+                return Err(Problem::TooManyObjects { count: n, kind });
             }
         }
         if self.output.width == 0 || self.output.height == 0 || self.output.width > 8192 || self.output.height > 8192 {
-            return bad(format!("[output] must be 1..8192 pixels each way, not {}×{}", self.output.width, self.output.height));
+            return Err(Problem::OutputSize(self.output.width, self.output.height));
         }
         if !(self.camera.fov > 1.0 && self.camera.fov < 170.0) {
-            return bad(format!("[camera] fov must be between 1 and 170 degrees, not {}", self.camera.fov));
+            return Err(Problem::FieldOfView(self.camera.fov));
         }
         if let Some(e) = self.quality.max_error
             && !(e > 0.0) {
-                return bad(format!("[quality] max_error must be positive, not {e}"));
+                return Err(Problem::MaxError(e));
             }
         if let Some(b) = self.quality.max_seconds {
             if !(b > 0.0 && b.is_finite()) {
-                return bad(format!("[quality] max_seconds must be a positive number of seconds, not {b}"));
+                return Err(Problem::MaxSeconds(b));
             }
             for (set, field) in [(self.quality.max_error.is_some(), "max_error"), (self.quality.samples.is_some(), "samples"), (self.quality.irradiance_source.is_some(), "irradiance_source")] {
                 if set {
-                    return bad(format!("[quality] max_seconds chooses the settings itself: give it or {field}, not both"));
+                    return Err(Problem::BudgetAndSetting(field));
                 }
             }
         }
@@ -179,8 +175,8 @@ impl Scene {
             ..d
         };
         match settings.validate() {
-            Err(splitsum::Error::Setting { field, problem }) => return bad(format!("[quality] {field} {problem}")),
-            Err(e) => return Err(e),
+            Err(splitsum::Error::Setting { field, problem }) => return Err(Problem::Setting { field, problem }),
+            Err(e) => return Err(Problem::Refused(e)),
             Ok(()) => {}
         }
         Ok(())
