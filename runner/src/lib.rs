@@ -6,6 +6,7 @@
 //! flags a user wrote.
 
 #![cfg_attr(not(test), warn(unused_crate_dependencies))]
+pub mod bars;
 pub mod cli;
 
 // The crates the subcommands call, under short names.

@@ -30,7 +30,8 @@ use crate::settings::{Job, Step};
 // What progress shows of an estimate, and from how long a step on: progress's own (it
 // depends on nothing here; the cost model this module reads depends on the backends,
 // which speak through progress).
-pub use crate::progress::{Estimate, SHOWN};
+pub use crate::progress::Estimate;
+use crate::progress::SHOWN;
 
 /// The share of its limit each step reaches, in the order of [`Step::ALL`], on 2 CPU cores:
 /// the median of limit/time over five quiet `runner bench --runs 1` of city.exr, with and

@@ -77,6 +77,7 @@ macro_rules! internal {
 
 pub mod environment;
 pub mod output;
+pub mod progress;
 pub mod texture;
 
 internal_modules! {
@@ -94,7 +95,6 @@ internal_modules! {
     ktx2;
     measured;
     preview;
-    progress;
     settings;
     table;
     textures;

@@ -270,19 +270,6 @@ impl Measurement {
         }
     }
 
-    /// The swept knob's value, as a number.
-    pub fn knob_value(&self) -> Option<f64> {
-        match self.knob {
-            Knob::Samples | Knob::Quality => self.samples.map(f64::from),
-            Knob::Size => self.size.map(f64::from),
-            Knob::Bias => self.bias.map(f64::from),
-            Knob::SourceSize => self.source_size.map(f64::from),
-            Knob::Fetches => self.fetches.map(f64::from),
-            Knob::Budget => self.budget_s,
-            Knob::None => None,
-        }
-    }
-
     /// What sets it apart in a table: the knobs that have values, in words.
     pub fn setting(&self) -> String {
         let mut parts = Vec::new();

@@ -108,7 +108,7 @@ pub(super) fn bake_command(args: BakeArgs, given: &[String]) -> anyhow::Result<(
     let manifest = write_bake(out, &baked, &job, about)?;
     for t in &manifest.timings {
         match t.estimate {
-            Some(e) if e >= splitsum::estimate::SHOWN || t.seconds >= splitsum::estimate::SHOWN => {
+            Some(e) if e >= splitsum::progress::SHOWN || t.seconds >= splitsum::progress::SHOWN => {
                 println!("  {:<12} {:>9.3} s (estimated {e:.3} s)", t.step.name(), t.seconds)
             }
             _ => println!("  {:<12} {:>9.3} s", t.step.name(), t.seconds),

@@ -477,7 +477,7 @@ where
     T: Into<std::ffi::OsString> + Clone,
 {
     use clap::{CommandFactory, FromArgMatches};
-    crate::progress::show(true);
+    crate::bars::install();
     crate::files::remove_staging_on_interrupt();
     let matches = Cli::command().try_get_matches_from(args)?;
     let cli = Cli::from_arg_matches(&matches)?;

@@ -3,9 +3,8 @@
 
 use super::kernels::{Kernels, Prefilter, chunks};
 use crate::error::Result;
-use crate::progress::bar as progress;
+use crate::progress::{Bar, bar as progress};
 use crate::texture::{Equirect, Sh9};
-use indicatif::ProgressBar;
 use rayon::prelude::*;
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
@@ -30,12 +29,11 @@ fn table(what: &str, size: u32, f: impl Fn(u32, u32) -> Vec4 + Sync) -> Vec<Vec4
         }
         bar.inc(1);
     });
-    bar.finish_and_clear();
     texels
 }
 
 /// Fills one level (`FACES · size` rows of `size` texels) with `f(face, x, y)`.
-fn fill_level(out: &mut [Vec4], size: u32, bar: &ProgressBar, f: impl Fn(u32, u32, u32) -> Vec4 + Sync) {
+fn fill_level(out: &mut [Vec4], size: u32, bar: &Bar, f: impl Fn(u32, u32, u32) -> Vec4 + Sync) {
     out.par_chunks_mut(size as usize).enumerate().for_each(|(row, texels)| {
         let face = row as u32 / size;
         let y = row as u32 % size;
@@ -101,8 +99,7 @@ impl Kernels for Cpu {
         let bar = progress("equirect", (FACES * size) as u64);
         let level0 = &mut texels[..(FACES * size * size) as usize];
         fill_level(level0, size, &bar, |face, x, y| equirect::cube_texel(&pyramid, env.width, env.height, levels, facing, face, x, y, size, supersample));
-        bar.finish_and_clear();
-        self.build_mips(&mut texels, layout)?;
+            self.build_mips(&mut texels, layout)?;
         Ok(texels)
     }
 
@@ -142,8 +139,7 @@ impl Kernels for Cpu {
                 fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(job.lobe, src, src_layout, face, x, y, s, r, n, job.lod_bias, e));
             }
         }
-        bar.finish_and_clear();
-        Ok(texels)
+            Ok(texels)
     }
 
     fn irradiance(&self, src: &Vec<Vec4>, src_layout: CubeLayout, level: u32, size: u32) -> Result<Vec<Vec4>> {
@@ -158,8 +154,7 @@ impl Kernels for Cpu {
         let input: Vec<Vec4> = src[start..start + n as usize].iter().copied().chain(cubemap::level_geometry(s)).collect();
         let one = CubeLayout::new(s, 1);
         fill_level(&mut texels, size, &bar, |face, x, y| irradiance::convolve_dir(&input, one, 0, n, cubemap::texel_dir(face, x, y, size)));
-        bar.finish_and_clear();
-        Ok(texels)
+            Ok(texels)
     }
 
     fn sh9(&self, src: &Vec<Vec4>, src_layout: CubeLayout, level: u32) -> Result<Sh9> {
@@ -178,7 +173,7 @@ impl Kernels for Cpu {
 
     fn calibrate(&self, src: &Vec<Vec4>, src_layout: CubeLayout, rate: Rate, size: u32, count: u32) -> Result<Vec<Vec4>> {
         let mut texels = vec![Vec4::ZERO; (FACES * size * size) as usize];
-        fill_level(&mut texels, size, &ProgressBar::hidden(), |face, x, y| calibrate::texel(src, src_layout, rate, face, x, y, size, count));
+        fill_level(&mut texels, size, &Bar::hidden(), |face, x, y| calibrate::texel(src, src_layout, rate, face, x, y, size, count));
         Ok(texels)
     }
 
