@@ -47,13 +47,14 @@ ensure_nightly() {
 }
 
 # What the committed SPIR-V is compiled from, and the module and linkage themselves, as one
-# hash (git's tracked files, read from the working tree; empty outside a git checkout).
+# hash (the files git tracks or would track, read from the working tree, so that a new
+# shader file counts before it is added; empty outside a git checkout).
 SPIRV_STAMP=spirv/src/compiled_from.sha256
 spirv_hash() {
     git rev-parse --is-inside-work-tree >/dev/null 2>&1 || return 0
     {
         echo "$NIGHTLY"
-        git ls-files -z -- shaders/src shaders/Cargo.toml xtask Cargo.toml Cargo.lock spirv/src/splitsum_shaders.spv spirv/src/linkage.rs \
+        git ls-files -z --cached --others --exclude-standard -- shaders/src shaders/Cargo.toml xtask Cargo.toml Cargo.lock spirv/src/splitsum_shaders.spv spirv/src/linkage.rs \
             | sort -z | xargs -0 sha256sum
     } | sha256sum | cut -d' ' -f1
 }

@@ -2,8 +2,10 @@
 //! the committed SPIR-V module of `splitsum-spirv`. Every entry point's name, workgroup
 //! size and bindings come from that crate's generated linkage; nothing here spells one.
 //!
-//! Start-up (device and every pipeline) happens in [`Gpu::new`] or [`Gpu::on_device`], so
-//! that the time of a bake excludes it. Each [`Gpu::run`] records its dispatches in one
+//! Start-up (device and the pipelines of every kernel a bake runs) happens in [`Gpu::new`]
+//! or [`Gpu::on_device`], so that the time of a bake excludes it; the kernels only tools
+//! run ([`ON_DEMAND`]: the sampled table, the table's quadrature, calibration, probes) are
+//! built when first needed, each checked as at start-up. Each [`Gpu::run`] records its dispatches in one
 //! command encoder and submits them: a step's levels together, and each chunk of a long sum
 //! (at most `math::CHUNK` terms, under drivers' time limits per submission) on its own; the
 //! chunks' partial sums are resolved on the device (`resolve_means`, `resolve_lut`) before
@@ -34,9 +36,19 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     /// What the adapter says of itself.
     pub info: wgpu::AdapterInfo,
-    pipelines: HashMap<&'static str, (wgpu::ComputePipeline, wgpu::BindGroupLayout)>,
+    pipelines: std::sync::RwLock<HashMap<&'static str, Pipeline>>,
     empty: wgpu::Buffer,
 }
+
+/// A kernel's pipeline and its bind group layout.
+type Pipeline = std::sync::Arc<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>;
+
+/// The kernels a bake never runs, built on first use natively ([`Gpu::ensure`]): the
+/// sampled BRDF table and the resolve of its chunks, the table's quadrature (the defaults'
+/// table is embedded, others are computed once per process), the calibration of the cost
+/// model and the probes of reports and tests. (In a browser, where nothing may block on
+/// the error scope that checks a pipeline, every pipeline is built at start-up.)
+pub const ON_DEMAND: [&EntryPoint; 5] = [&spirv::KERNELS_BRDF_LUT, &spirv::KERNELS_RESOLVE_LUT, &spirv::KERNELS_BRDF_TABLE, &spirv::KERNELS_CALIBRATE, &spirv::KERNELS_PROBE];
 
 /// One dispatch: a kernel, its parameter block, an optional input and the output buffer,
 /// bound where the kernel's generated linkage says (its uniform, its read-only storage
@@ -241,8 +253,10 @@ impl Gpu {
             return Err(Error::gpu_caused(format!("the shader module did not validate on {}", info.name), e.to_string()));
         }
         // Each pipeline checked in an error scope of its own, so that an error names its
-        // kernel. The cube reader binds a texture of the caller's format: built when needed.
-        let kernels: Vec<&EntryPoint> = splitsum_spirv::KERNELS.iter().filter(|k| k.name != spirv::KERNELS_READ_CUBE.name).collect();
+        // kernel. The cube reader binds a texture of the caller's format: built when needed;
+        // natively, so are the kernels of tools alone (`ON_DEMAND`).
+        let later = |k: &&EntryPoint| k.name == spirv::KERNELS_READ_CUBE.name || (cfg!(not(target_arch = "wasm32")) && ON_DEMAND.iter().any(|o| o.name == k.name));
+        let kernels: Vec<&EntryPoint> = splitsum_spirv::KERNELS.iter().filter(|k| !later(k)).collect();
         let build = |k: &EntryPoint| {
             let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
@@ -277,7 +291,7 @@ impl Gpu {
             if let Some(e) = error {
                 return Err(Error::gpu_caused(format!("kernel {name} did not validate on {}", info.name), e.to_string()));
             }
-            pipelines.insert(name, (pipeline, layout));
+            pipelines.insert(name, std::sync::Arc::new((pipeline, layout)));
         }
         let empty = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("empty input"),
@@ -285,7 +299,38 @@ impl Gpu {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        Ok(Self { instance: None, adapter: None, module, device: device.clone(), queue: queue.clone(), info, pipelines, empty })
+        Ok(Self { instance: None, adapter: None, module, device: device.clone(), queue: queue.clone(), info, pipelines: std::sync::RwLock::new(pipelines), empty })
+    }
+
+    /// Builds the pipeline of kernel `k` if it is not built yet (the kernels of
+    /// [`ON_DEMAND`]), checked in an error scope of its own as at start-up.
+    #[cfg(not(target_arch = "wasm32"))]
+    pub(crate) fn ensure(&self, k: &'static EntryPoint) -> Result<()> {
+        if self.pipelines.read().unwrap_or_else(|e| e.into_inner()).contains_key(k.name) {
+            return Ok(());
+        }
+        let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let layout = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
+        let pipeline = kernel_pipeline(&self.device, &self.module, k, &layout);
+        if let Some(e) = pollster::block_on(scope.pop()) {
+            return Err(Error::gpu_caused(format!("kernel {} did not validate on {}", k.name, self.info.name), e.to_string()));
+        }
+        self.pipelines.write().unwrap_or_else(|e| e.into_inner()).entry(k.name).or_insert_with(|| std::sync::Arc::new((pipeline, layout)));
+        Ok(())
+    }
+
+    /// In a browser every pipeline is built at start-up.
+    #[cfg(target_arch = "wasm32")]
+    pub(crate) fn ensure(&self, _k: &'static EntryPoint) -> Result<()> {
+        Ok(())
+    }
+
+    /// The pipeline of kernel `k`, built at start-up or by [`Gpu::ensure`].
+    fn pipeline(&self, k: &EntryPoint) -> Pipeline {
+        match self.pipelines.read().unwrap_or_else(|e| e.into_inner()).get(k.name) {
+            Some(p) => p.clone(),
+            None => panic!("kernel {} is run before its pipeline is built (Gpu::ensure)", k.name),
+        }
     }
 
     /// A one-line description of the adapter and its API.
@@ -345,10 +390,12 @@ impl Gpu {
                     filled(&self.device, &self.queue, "params", &bytes, wgpu::BufferUsages::UNIFORM)
                 })
                 .collect();
+            let pipelines: Vec<Pipeline> = dispatches.iter().map(|d| self.pipeline(d.kernel)).collect();
             let groups: Vec<wgpu::BindGroup> = dispatches
                 .iter()
                 .zip(&params)
-                .map(|(d, p)| {
+                .zip(&pipelines)
+                .map(|((d, p), pipeline)| {
                     let entries: Vec<wgpu::BindGroupEntry> = d
                         .kernel
                         .bindings
@@ -363,13 +410,13 @@ impl Gpu {
                             wgpu::BindGroupEntry { binding: b.binding, resource: buffer.as_entire_binding() }
                         })
                         .collect();
-                    self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &self.pipelines[d.kernel.name].1, entries: &entries })
+                    self.device.create_bind_group(&wgpu::BindGroupDescriptor { label: None, layout: &pipeline.1, entries: &entries })
                 })
                 .collect();
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor { label: None, timestamp_writes: None });
-            for (d, g) in dispatches.iter().zip(&groups) {
+            for ((d, g), pipeline) in dispatches.iter().zip(&groups).zip(&pipelines) {
                 let [x, y, z] = d.kernel.workgroups(d.invocations);
-                pass.set_pipeline(&self.pipelines[d.kernel.name].0);
+                pass.set_pipeline(&pipeline.0);
                 pass.set_bind_group(0, g, &[]);
                 pass.dispatch_workgroups(x, y, z);
             }

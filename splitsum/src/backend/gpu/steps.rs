@@ -302,6 +302,8 @@ impl Kernels for Gpu {
         if !self.fits("the BRDF table", &[bytes(n as u64)]) {
             return self.upload("brdf lut", &Cpu.brdf_lut(size, samples)?);
         }
+        self.ensure(&spirv::KERNELS_BRDF_LUT)?;
+        self.ensure(&spirv::KERNELS_RESOLVE_LUT)?;
         let accum = self.output("brdf lut sums", bytes(n as u64))?;
         for (start, count) in chunks(samples) {
             self.table_rows(&spirv::KERNELS_BRDF_LUT, size, count, &accum, |row_offset| LutParams { size, samples, row_offset, start, count });
@@ -323,6 +325,7 @@ impl Kernels for Gpu {
         if !self.fits("the BRDF table", &[bytes(n as u64)]) {
             return self.upload("brdf table", &Cpu.brdf_table(size, masking)?);
         }
+        self.ensure(&spirv::KERNELS_BRDF_TABLE)?;
         let out = self.texels("brdf table", n)?;
         let per_texel = lut::QUADRATURE_MEAN_EVALUATIONS;
         self.table_rows(&spirv::KERNELS_BRDF_TABLE, size, per_texel, &out.buffer, |row_offset| TableParams { size, masking: masking as u32, row_offset });
@@ -330,6 +333,7 @@ impl Kernels for Gpu {
     }
 
     fn calibrate(&self, src: &Texels, src_layout: CubeLayout, rate: Rate, size: u32, count: u32) -> Result<Texels> {
+        self.ensure(&spirv::KERNELS_CALIBRATE)?;
         let out = self.texels("calibration", FACES * size * size)?;
         let p = CalibrateParams { rate: rate as u32, size, src_size: src_layout.size, src_levels: src_layout.levels, count };
         self.run(&[Dispatch { kernel: &spirv::KERNELS_CALIBRATE, params: bytemuck::bytes_of(&p), input: Some(&src.buffer), output: &out.buffer, invocations: [size, size, FACES] }]);
@@ -340,6 +344,7 @@ impl Kernels for Gpu {
         if !self.fits("the probes", &[bytes((texels.len() + probes.len()) as u64), 3 * bytes(probes.len() as u64)]) {
             return Cpu.probe_raw(p, texels, probes, terms);
         }
+        self.ensure(&spirv::KERNELS_PROBE)?;
         let mut input = texels.to_vec();
         input.extend_from_slice(probes);
         let buf = self.upload_bytes("probes", bytemuck::cast_slice(&input));
