@@ -43,7 +43,7 @@ pub struct Gpu {
 /// A kernel's pipeline and its bind group layout.
 type Pipeline = std::sync::Arc<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>;
 
-/// The kernels a bake never runs, built on first use natively ([`Gpu::ensure`]): the
+/// The kernels a bake never runs, built on first use natively (`Gpu::ensure`): the
 /// sampled BRDF table and the resolve of its chunks, the table's quadrature (the defaults'
 /// table is embedded, others are computed once per process), the calibration of the cost
 /// model and the probes of reports and tests. (In a browser, where nothing may block on
