@@ -144,16 +144,7 @@ impl App {
             .and_then(|p| splitsum::files::write_png(&path, w, h, &crate::render::to_rgb8(&p)));
         match result {
             Ok(()) => println!("wrote {}", path.display()),
-            Err(e) => {
-                // The message and what failed underneath it, as the command line prints errors.
-                let mut text = e.to_string();
-                let mut cause = std::error::Error::source(&e);
-                while let Some(c) = cause {
-                    text += &format!(": {c}");
-                    cause = c.source();
-                }
-                eprintln!("screenshot: {text}");
-            }
+            Err(e) => eprintln!("screenshot: {}", splitsum::error::chain(&e)),
         }
     }
 

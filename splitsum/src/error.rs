@@ -109,5 +109,17 @@ impl Error {
     }
 }
 
+/// `e` and what failed underneath it, one cause after another (as `anyhow`'s `{:#}` prints
+/// a chain): for messages that go on after an error, where no `anyhow` is at hand.
+pub fn chain(e: &(dyn std::error::Error + 'static)) -> String {
+    let mut text = e.to_string();
+    let mut cause = e.source();
+    while let Some(c) = cause {
+        text += &format!(": {c}");
+        cause = c.source();
+    }
+    text
+}
+
 /// splitsum's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;

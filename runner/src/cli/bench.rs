@@ -54,7 +54,7 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
         let backend = match Backend::open(*kind) {
             Ok(b) => b,
             Err(e) => {
-                println!("{kind:?}: skipped ({})", said(&e));
+                println!("{kind:?}: skipped ({})", splitsum::error::chain(&e));
                 continue;
             }
         };

@@ -12,7 +12,7 @@ pub(super) fn default_run() -> anyhow::Result<()> {
     let backend = match Backend::open(BackendKind::Auto) {
         Ok(b) => b,
         Err(e) => {
-            eprintln!("{}\nfalling back to the CPU backend", said(&e));
+            eprintln!("{}\nfalling back to the CPU backend", splitsum::error::chain(&e));
             Backend::Cpu
         }
     };
@@ -44,8 +44,8 @@ pub(super) fn default_run() -> anyhow::Result<()> {
         let options = crate::view::ViewOptions { size: (960, 540), ..Default::default() };
         match gpu.map(|gpu| crate::view::run(gpu, &baked, None, state.clone(), options)) {
             Ok(Ok(())) => return Ok(()),
-            Ok(Err(e)) => eprintln!("{}; rendering to a file instead", said(&e)),
-            Err(e) => eprintln!("{}; rendering to a file instead", said(&e)),
+            Ok(Err(e)) => eprintln!("{}; rendering to a file instead", splitsum::error::chain(&e)),
+            Err(e) => eprintln!("{}; rendering to a file instead", splitsum::error::chain(&e)),
         }
         Backend::open(BackendKind::Auto).unwrap_or(Backend::Cpu)
     } else {

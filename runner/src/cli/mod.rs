@@ -395,18 +395,6 @@ pub fn exit_code(e: &anyhow::Error) -> i32 {
     }
 }
 
-/// An error and what failed underneath it, one cause after another (as `anyhow`'s `{:#}`):
-/// for notes that go on after an error.
-pub(crate) fn said(e: &(dyn std::error::Error + 'static)) -> String {
-    let mut text = e.to_string();
-    let mut cause = e.source();
-    while let Some(c) = cause {
-        text += &format!(": {c}");
-        cause = c.source();
-    }
-    text
-}
-
 /// A library error in the user's terms: a setting by the flag `flag` names for it, a refused
 /// long bake with the flags that set its cost and `--force`, unreadable texels with
 /// `--sanitize`.

@@ -35,7 +35,7 @@ pub(super) fn report(args: ReportArgs) -> anyhow::Result<()> {
     for kind in &args.backends {
         match Backend::open(*kind) {
             Ok(b) => backends.push(b),
-            Err(e) => eprintln!("{kind:?}: skipped ({})", said(&e)),
+            Err(e) => eprintln!("{kind:?}: skipped ({})", splitsum::error::chain(&e)),
         }
     }
     anyhow::ensure!(!backends.is_empty(), "no backend could be opened");
