@@ -74,31 +74,17 @@ fn modules(dir: &Path, path: &str, items: Vec<syn::Item>, out: &mut BTreeMap<Str
     out.insert(path.to_string(), items);
 }
 
-/// What an item is, in the list's words, and its name.
-fn kind_and_name(item: &syn::Item) -> Option<(&'static str, String)> {
+/// What an item is, in the list's words, its name, its visibility and its attributes.
+fn describe(item: &syn::Item) -> Option<(&'static str, String, &syn::Visibility, &[syn::Attribute])> {
     Some(match item {
-        syn::Item::Struct(i) => ("struct", i.ident.to_string()),
-        syn::Item::Enum(i) => ("enum", i.ident.to_string()),
-        syn::Item::Fn(i) => ("fn", i.sig.ident.to_string()),
-        syn::Item::Const(i) => ("const", i.ident.to_string()),
-        syn::Item::Static(i) => ("static", i.ident.to_string()),
-        syn::Item::Type(i) => ("type", i.ident.to_string()),
-        syn::Item::Trait(i) => ("trait", i.ident.to_string()),
-        syn::Item::Mod(i) => ("mod", i.ident.to_string()),
-        _ => return None,
-    })
-}
-
-fn vis_of(item: &syn::Item) -> Option<(&syn::Visibility, &[syn::Attribute])> {
-    Some(match item {
-        syn::Item::Struct(i) => (&i.vis, &i.attrs),
-        syn::Item::Enum(i) => (&i.vis, &i.attrs),
-        syn::Item::Fn(i) => (&i.vis, &i.attrs),
-        syn::Item::Const(i) => (&i.vis, &i.attrs),
-        syn::Item::Static(i) => (&i.vis, &i.attrs),
-        syn::Item::Type(i) => (&i.vis, &i.attrs),
-        syn::Item::Trait(i) => (&i.vis, &i.attrs),
-        syn::Item::Mod(i) => (&i.vis, &i.attrs),
+        syn::Item::Struct(i) => ("struct", i.ident.to_string(), &i.vis, &i.attrs),
+        syn::Item::Enum(i) => ("enum", i.ident.to_string(), &i.vis, &i.attrs),
+        syn::Item::Fn(i) => ("fn", i.sig.ident.to_string(), &i.vis, &i.attrs),
+        syn::Item::Const(i) => ("const", i.ident.to_string(), &i.vis, &i.attrs),
+        syn::Item::Static(i) => ("static", i.ident.to_string(), &i.vis, &i.attrs),
+        syn::Item::Type(i) => ("type", i.ident.to_string(), &i.vis, &i.attrs),
+        syn::Item::Trait(i) => ("trait", i.ident.to_string(), &i.vis, &i.attrs),
+        syn::Item::Mod(i) => ("mod", i.ident.to_string(), &i.vis, &i.attrs),
         _ => return None,
     })
 }
@@ -159,11 +145,10 @@ fn public_api() -> (Vec<String>, Vec<String>) {
                 }
                 continue;
             }
-            let Some((vis, attrs)) = vis_of(item) else { continue };
+            let Some((kind, name, vis, attrs)) = describe(item) else { continue };
             if !is_pub(vis) || left_out(attrs) {
                 continue;
             }
-            let (kind, name) = kind_and_name(item).unwrap();
             items.insert(format!("{kind} {module}::{name}"));
             if kind == "mod" {
                 queue.push(format!("{module}::{name}"));
@@ -209,7 +194,7 @@ fn resolve(all: &BTreeMap<String, Vec<syn::Item>>, module: &str, path: &str) -> 
     // A definition first (a module may also import a name it defines, as `thiserror::Error`
     // beside `enum Error`), then what the module itself imports.
     for item in items {
-        if let Some((kind, n)) = kind_and_name(item)
+        if let Some((kind, n, _, _)) = describe(item)
             && n == name
         {
             return (kind, ["struct", "enum", "trait"].contains(&kind).then(|| n.clone()));

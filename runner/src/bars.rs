@@ -52,14 +52,16 @@ impl Terminal {
                     return;
                 }
                 let mut loops = self.loops.lock().unwrap_or_else(|e| e.into_inner());
-                let bar = loops.entry(what.to_string()).or_insert_with(|| {
+                // Called for every row of a loop: the name is copied only when its bar is made.
+                if !loops.contains_key(what) {
                     let bar = self.multi.add(ProgressBar::new(len));
                     bar.set_style(
                         ProgressStyle::with_template("{prefix:>14} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})").expect("valid template").progress_chars("=> "),
                     );
                     bar.set_prefix(what.to_string());
-                    bar
-                });
+                    loops.insert(what.to_string(), bar);
+                }
+                let bar = &loops[what];
                 bar.set_length(len);
                 bar.set_position(done);
                 if done >= len

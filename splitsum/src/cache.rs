@@ -138,8 +138,10 @@ pub enum Rejection {
     WrongHash(&'static str),
     /// A file that changed while it was read.
     Changed(&'static str),
-    /// A file that does not hold what its name says (a cube, or a table).
-    NotItsProduct(&'static str),
+    /// A file that does not hold the cube its name says.
+    NotACube(&'static str),
+    /// A file that does not hold the table its name says.
+    NotATable(&'static str),
 }
 
 impl std::fmt::Display for Rejection {
@@ -154,7 +156,8 @@ impl std::fmt::Display for Rejection {
             Rejection::WrongSize { name, bytes, listed } => write!(f, "{name} is corrupt (it holds {bytes} bytes, the manifest says {listed})"),
             Rejection::WrongHash(name) => write!(f, "{name} is corrupt (its BLAKE3 hash differs from the manifest)"),
             Rejection::Changed(name) => write!(f, "{name} changed while it was read"),
-            Rejection::NotItsProduct(name) => write!(f, "{name} does not hold {}", if name.ends_with("lut.bin") || name.ends_with("tables.bin") { "a table" } else { "a cube" }),
+            Rejection::NotACube(name) => write!(f, "{name} does not hold a cube"),
+            Rejection::NotATable(name) => write!(f, "{name} does not hold a table"),
         }
     }
 }
@@ -280,8 +283,8 @@ impl Cache {
             }
             Ok(bytes)
         };
-        let cube = |name: &'static str| cube_from(&file(name)?).ok_or(Rejection::NotItsProduct(name));
-        let table = |name: &'static str| table_from(&file(name)?).ok_or(Rejection::NotItsProduct(name));
+        let cube = |name: &'static str| cube_from(&file(name)?).ok_or(Rejection::NotACube(name));
+        let table = |name: &'static str| table_from(&file(name)?).ok_or(Rejection::NotATable(name));
         let (source, specular, irradiance, lut) = (cube("source.bin")?, cube("specular.bin")?, cube("irradiance.bin")?, table("lut.bin")?);
         let (sheen, sheen_tables) = (cube("sheen.bin")?, table("sheen_tables.bin")?);
         Ok(BakedEnvironment { source, specular, irradiance, lut, sheen, sheen_tables, mapping: RoughnessMapping::from_u32(m.mapping) })
