@@ -11,6 +11,7 @@ mod sphere;
 #[allow(dead_code)]
 mod app;
 
+use splitsum::Product;
 use splitsum::texture::{Cube, Equirect};
 use splitsum::{Baker, Compute, Environment, Settings, Source};
 use splitsum_reference as reference;
@@ -36,9 +37,9 @@ struct Data {
 
 fn data(b: splitsum::Baked) -> Data {
     Data {
-        specular: b.specular.expect("read back"),
-        irradiance: b.irradiance.expect("read back"),
-        brdf: b.lut.expect("read back").texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect(),
+        specular: b.cube(Product::Specular).cloned().expect("read back"),
+        irradiance: b.cube(Product::Irradiance).cloned().expect("read back"),
+        brdf: b.table(Product::BrdfTable).cloned().expect("read back").texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect(),
     }
 }
 
@@ -121,13 +122,13 @@ fn the_baker_makes_sheen_textures_when_asked() {
         ibl.read(d, q).unwrap()
     };
     let (gpu, cpu) = (read(Compute::Gpu), read(Compute::Cpu));
-    let (g, c) = (gpu.sheen.expect("read back"), cpu.sheen.expect("read back"));
+    let (g, c) = (gpu.cube(Product::Sheen).cloned().expect("read back"), cpu.cube(Product::Sheen).cloned().expect("read back"));
     let peak = c.texels.iter().map(|v| v.max_element()).fold(0.0f32, f32::max);
     let worst = g.texels.iter().zip(&c.texels).map(|(x, y)| ((*x - *y).abs() / y.abs().max(Vec4::splat(1e-3 * peak))).max_element()).fold(0.0f32, f32::max);
     eprintln!("sheen: GPU vs CPU textures, largest relative difference {worst:.2e}");
     assert!(worst <= 2.0f32.powi(-10), "{worst:e}");
     let embedded = splitsum::table::sheen_texels();
-    for tables in [gpu.sheen_tables.expect("read back"), cpu.sheen_tables.expect("read back")] {
+    for tables in [gpu.table(Product::SheenTables).cloned().expect("read back"), cpu.table(Product::SheenTables).cloned().expect("read back")] {
         for (t, e) in tables.texels.iter().zip(embedded.iter()) {
             assert!((t.x - e.x).abs() <= 2.0f32.powi(-11) * e.x.max(1e-3) && (t.y - e.y).abs() <= 2.0f32.powi(-11) * e.y.max(1e-3), "{t} against {e}");
         }
@@ -238,7 +239,7 @@ fn the_baker_takes_an_engine_target() {
     let env = Environment::Equirect(Equirect { width: w as u32, height: h as u32, texels });
     let s = Settings { size: 32, irradiance_size: 8, lut_size: 32, ..Settings::default() }.with_target(splitsum::Target::Khronos);
     let job = s.resolve(splitsum::settings::InputShape::of(&env), splitsum::Products::DISPLAY).unwrap();
-    assert_eq!((job.mips, job.roughness_per_mip[1]), (5, 0.25), "floor(log2 32) mips at m/(M - 1)");
+    assert_eq!((job.mips, job.roughness_per_mip()[1]), (5, 0.25), "floor(log2 32) mips at m/(M - 1)");
     let (u, v) = ((px as f64 + 0.5) / w as f64, (py as f64 + 0.5) / h as f64);
     let (phi, theta) = (std::f64::consts::TAU * (u - 0.5), std::f64::consts::PI * v);
     let want = [theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin()];

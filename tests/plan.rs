@@ -2,6 +2,7 @@
 //! a render from the reduced bake equals the render from a full bake, unchanged bakes come
 //! from the cache, and corrupt or foreign entries are rebuilt, never used.
 
+use splitsum::Product;
 use splitsum::Backend;
 use splitsum::bake::BakedEnvironment;
 use splitsum::cache::{Cache, Lookup, Rejection};
@@ -49,10 +50,10 @@ fn skipped(p: &Plan, subject: Subject) -> bool {
 #[test]
 fn a_full_scene_keeps_everything() {
     let p = planned(&scene("", &material("all", "metallic = [0.0, 1.0]\nroughness = [0.0, 1.0]")));
-    assert_eq!((p.job.products.specular, p.job.products.lut, p.job.products.irradiance), (true, true, true));
-    assert_eq!(p.job.levels, (0..p.job.mips).collect::<Vec<_>>());
+    assert_eq!((p.job.products.has(Product::Specular), p.job.products.has(Product::BrdfTable), p.job.products.has(Product::Irradiance)), (true, true, true));
+    assert_eq!(p.job.prefiltered[&Product::Specular].levels, (0..p.job.mips).collect::<Vec<_>>());
     assert_eq!(p.job.size, 256, "roughness 0 needs the environment's full resolution");
-    assert!(!p.job.products.sh9, "the display reads the irradiance cube, not SH9");
+    assert!(!p.job.products.has(Product::Sh9), "the display reads the irradiance cube, not SH9");
     assert!((p.cost.cpu_seconds - p.full_cost.cpu_seconds).abs() < 1e-9);
 }
 
@@ -63,15 +64,15 @@ fn a_full_scene_keeps_everything() {
 #[test]
 fn sheen_is_baked_only_where_a_material_has_it() {
     let plain = planned(&scene("", &material("plain", "roughness = [0.2, 0.6]")));
-    assert!(!plain.job.products.sheen && skipped(&plain, Subject::Sheen));
+    assert!(!plain.job.products.has(Product::Sheen) && skipped(&plain, Subject::Sheen));
     let env = Environment::Equirect(support::environment("courtyard"));
     let baked = splitsum::bake::bake_job(&Backend::Cpu, &env, &plain.job).unwrap();
-    assert!(baked.sheen.is_none() && baked.sheen_tables.is_none());
-    assert!(!baked.timings.iter().any(|t| matches!(t.step, splitsum::settings::Step::Sheen | splitsum::settings::Step::SheenTables)), "{:?}", baked.timings);
+    assert!(baked.cube(Product::Sheen).is_none() && baked.table(Product::SheenTables).is_none());
+    assert!(!baked.timings.iter().any(|t| matches!(t.step, Product::Sheen | Product::SheenTables)), "{:?}", baked.timings);
     let black = planned(&scene("", &material("black", "sheen_color = [0.0, 0.0, 0.0]\nsheen_roughness = 0.5")));
-    assert!(!black.job.products.sheen, "a black sheen colour is no sheen");
+    assert!(!black.job.products.has(Product::Sheen), "a black sheen colour is no sheen");
     let unlit = planned(&scene("", &material("unlit", "ibl = false\nsheen_color = [1.0, 1.0, 1.0]")));
-    assert!(!unlit.job.products.sheen, "a material not lit by the environment reads no sheen cube");
+    assert!(!unlit.job.products.has(Product::Sheen), "a material not lit by the environment reads no sheen cube");
     // A glTF model whose file has KHR_materials_sheen needs the sheen cube, every mip.
     let dir = std::env::temp_dir().join(format!("splitsum-plan-sheen-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -79,23 +80,23 @@ fn sheen_is_baked_only_where_a_material_has_it() {
     std::fs::write(&glb, support::model::sample_glb_with(Some(serde_json::json!({"KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5]}})))).unwrap();
     let text = format!("[[materials]]\nname = \"m\"\nroughness = \"texture\"\nmetallic = \"texture\"\n\n[[objects]]\nkind = \"gltf\"\npath = {:?}\nmaterial = \"m\"\n", glb.display().to_string());
     let p = planned(&scene("", &text));
-    assert!(p.job.products.sheen && p.job.sheen_levels == (0..p.job.mips).collect::<Vec<_>>(), "{:?}", p.decisions);
+    assert!(p.job.products.has(Product::Sheen) && p.job.prefiltered[&Product::Sheen].levels == (0..p.job.mips).collect::<Vec<_>>(), "{:?}", p.decisions);
     let torus = planned(&scene("", &model("m", "roughness = \"texture\"\nmetallic = \"texture\"")));
-    assert!(!torus.job.products.sheen, "the torus has no sheen");
+    assert!(!torus.job.products.has(Product::Sheen), "the torus has no sheen");
     let _ = std::fs::remove_dir_all(&dir);
     let velvet = planned(&scene("", &material("velvet", "sheen_color = [0.8, 0.2, 0.2]\nsheen_roughness = [0.3, 0.5]")));
-    assert!(velvet.job.products.sheen);
+    assert!(velvet.job.products.has(Product::Sheen));
     let top = (velvet.job.mips - 1) as f32;
     let want: Vec<u32> = ((0.3 * top).floor() as u32..=(0.5 * top).ceil() as u32).collect();
-    assert_eq!(velvet.job.sheen_levels, want, "the sheen mips around sheen roughness 0.3–0.5 of {} mips", velvet.job.mips);
+    assert_eq!(velvet.job.prefiltered[&Product::Sheen].levels, want, "the sheen mips around sheen roughness 0.3–0.5 of {} mips", velvet.job.mips);
 }
 
 #[test]
 fn no_specular_image_light_drops_the_prefilter_and_the_table() {
     for fields in ["specular = \"none\"", "specular = \"none\"\ndiffuse = \"oren-nayar\""] {
         let p = planned(&scene("", &material("clay", fields)));
-        assert!(!p.job.products.specular && !p.job.products.lut && p.job.products.irradiance, "{fields}: {p:?}");
-        assert!(p.job.levels.is_empty());
+        assert!(!p.job.products.has(Product::Specular) && !p.job.products.has(Product::BrdfTable) && p.job.products.has(Product::Irradiance), "{fields}: {p:?}");
+        assert!(p.job.prefiltered[&Product::Specular].levels.is_empty());
         assert!(skipped(&p, Subject::SpecularCube) && skipped(&p, Subject::BrdfTable));
         assert!(p.cost.cpu_seconds < p.full_cost.cpu_seconds);
     }
@@ -104,18 +105,18 @@ fn no_specular_image_light_drops_the_prefilter_and_the_table() {
 #[test]
 fn a_blurred_sky_keeps_only_the_mips_it_reads() {
     let p = planned(&scene("sky_blur = 2.5", &material("clay", "specular = \"none\"")));
-    assert!(p.job.products.specular && !p.job.products.lut);
-    assert_eq!(p.job.levels, vec![2, 3]);
+    assert!(p.job.products.has(Product::Specular) && !p.job.products.has(Product::BrdfTable));
+    assert_eq!(p.job.prefiltered[&Product::Specular].levels, vec![2, 3]);
 }
 
 #[test]
 fn only_metals_drop_the_irradiance() {
     let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.0, 1.0]")));
-    assert!(p.job.products.specular && p.job.products.lut && !p.job.products.irradiance);
+    assert!(p.job.products.has(Product::Specular) && p.job.products.has(Product::BrdfTable) && !p.job.products.has(Product::Irradiance));
     assert!(skipped(&p, Subject::IrradianceCube));
     // A metalness range that reaches below 1 needs it again.
     let p = planned(&scene("", &material("alloy", "metallic = [0.9, 1.0]")));
-    assert!(p.job.products.irradiance);
+    assert!(p.job.products.has(Product::Irradiance));
 }
 
 #[test]
@@ -126,28 +127,28 @@ fn a_roughness_range_keeps_the_mips_around_it() {
     // upper neighbour).
     let p = planned(&scene("", &material("steel", "metallic = 1.0\nroughness = [0.4, 0.7]")));
     assert_eq!(p.job.mips, 4);
-    assert_eq!(p.job.levels, vec![1, 2, 3]);
+    assert_eq!(p.job.prefiltered[&Product::Specular].levels, vec![1, 2, 3]);
     assert!(skipped(&p, Subject::SpecularMips));
     // A single roughness: 0.6 (α = 0.36) on a 32² cube (M = 3) reads lod 1 + (log₂0.36 + 3)/3
     // = 1.51: mips 1 and 2.
     let p = planned(&scene("", &material("satin", "roughness = 0.6")));
-    assert_eq!((p.job.size, p.job.levels.clone()), (32, vec![1, 2]));
+    assert_eq!((p.job.size, p.job.prefiltered[&Product::Specular].levels.clone()), (32, vec![1, 2]));
     // Two materials: the union of their mips. r = 0.2 needs the 256² cube (M = 6, lod 1.90);
     // r = 0.85 and 0.9 read lod 4.69 and 4.80.
     let two = format!("{}{}", material("a", "roughness = 0.2"), model("b", "roughness = [0.85, 0.9]"));
-    assert_eq!(planned(&scene("", &two)).job.levels, vec![1, 2, 4, 5]);
+    assert_eq!(planned(&scene("", &two)).job.prefiltered[&Product::Specular].levels, vec![1, 2, 4, 5]);
 }
 
 #[test]
 fn phong_and_blinn_phong_need_no_ggx_table() {
     for model in ["phong", "blinn-phong"] {
         let p = planned(&scene("", &material("plastic", &format!("specular = {model:?}\nroughness = [0.2, 0.6]"))));
-        assert!(p.job.products.specular && p.job.products.irradiance && !p.job.products.lut, "{model}");
+        assert!(p.job.products.has(Product::Specular) && p.job.products.has(Product::Irradiance) && !p.job.products.has(Product::BrdfTable), "{model}");
         assert!(skipped(&p, Subject::BrdfTable));
     }
     // One Cook–Torrance material among them brings it back.
     let two = format!("{}{}", material("a", "specular = \"phong\""), model("b", "specular = \"cook-torrance\""));
-    assert!(planned(&scene("", &two)).job.products.lut);
+    assert!(planned(&scene("", &two)).job.products.has(Product::BrdfTable));
 }
 
 #[test]
@@ -172,8 +173,8 @@ fn a_scene_draws_every_object_or_is_refused() {
 fn no_image_light_bakes_nothing() {
     for body in [material("unlit", "ibl = false"), String::new()] {
         let p = planned(&scene("", &body));
-        assert!(!p.job.products.specular && !p.job.products.lut && !p.job.products.irradiance && !p.job.products.sh9);
-        assert!(p.job.levels.is_empty());
+        assert!(!p.job.products.has(Product::Specular) && !p.job.products.has(Product::BrdfTable) && !p.job.products.has(Product::Irradiance) && !p.job.products.has(Product::Sh9));
+        assert!(p.job.prefiltered[&Product::Specular].levels.is_empty());
         assert!(skipped(&p, Subject::Everything));
     }
 }
@@ -303,11 +304,11 @@ fn renders_from_reduced_bakes_equal_renders_from_full_bakes() {
     for (name, head, body) in cases {
         let s = scene(&head, &format!("{body}\n{QUICK}\n[[lights]]\nkind = \"directional\"\ndirection = [0.3, 1.0, 0.5]\nradiance = [2.0, 2.0, 2.0]"));
         let (p, reduced, full) = reduced_and_full(&s, &env);
-        let left_out = !(p.job.products.specular && p.job.products.lut && p.job.products.irradiance) || p.job.levels.len() < p.job.mips as usize;
+        let left_out = !(p.job.products.has(Product::Specular) && p.job.products.has(Product::BrdfTable) && p.job.products.has(Product::Irradiance)) || p.job.prefiltered[&Product::Specular].levels.len() < p.job.mips as usize;
         assert!(left_out, "{name}: the plan should leave something out");
         let cpu = max_abs(&render(&s, &reduced, &Backend::Cpu), &render(&s, &full, &Backend::Cpu));
         let lava = max_abs(&render(&s, &reduced, gpu), &render(&s, &full, gpu));
-        println!("{name}: levels {:?} of {}, products {:?}: reduced vs full, CPU {cpu:e}, GPU {lava:e}", p.job.levels, p.job.mips, p.job.products);
+        println!("{name}: levels {:?} of {}, products {:?}: reduced vs full, CPU {cpu:e}, GPU {lava:e}", p.job.prefiltered[&Product::Specular].levels, p.job.mips, p.job.products);
         assert_eq!(cpu, 0.0, "{name}: the reduced bake changed the CPU render");
         assert!(lava <= 1e-6, "{name}: the reduced bake changed the GPU render by {lava}");
     }
@@ -322,7 +323,7 @@ fn temp(name: &str) -> PathBuf {
 }
 
 fn same(a: &BakedEnvironment, b: &BakedEnvironment) -> bool {
-    a.source.texels == b.source.texels && a.specular.texels == b.specular.texels && a.irradiance.texels == b.irradiance.texels && a.lut.texels == b.lut.texels
+    a.cube(Product::SourceCube).texels == b.cube(Product::SourceCube).texels && a.cube(Product::Specular).texels == b.cube(Product::Specular).texels && a.cube(Product::Irradiance).texels == b.cube(Product::Irradiance).texels && a.table(Product::BrdfTable).texels == b.table(Product::BrdfTable).texels
 }
 
 fn entry_file(dir: &Path, key: &str, name: &str) -> PathBuf {
@@ -506,7 +507,7 @@ fn the_example_scenes_plan_and_a_scene_bake_is_cached() {
     let args = ["runner", "bake", "--scene", file.to_str().unwrap(), "--backend", "cpu", "--cache", cache.to_str().unwrap(), "--out", out.to_str().unwrap()];
     runner::cli::run(args).expect("first bake");
     let plan_json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("plan.json")).unwrap()).unwrap();
-    assert_eq!(plan_json["plan"]["job"]["products"]["irradiance"], false);
+    assert!(!plan_json["plan"]["job"]["products"].as_array().unwrap().iter().any(|p| p == "irradiance"), "{}", plan_json["plan"]["job"]["products"]);
     assert!(out.join("specular.ktx2").exists() && out.join("brdf_lut.exr").exists());
     assert!(!out.join("irradiance.ktx2").exists(), "left-out products are not written");
     // specular.ktx2 holds mips 1 … 2 of the 32² cube (M = 3: r = 0, √⅛, 1; r ∈ [0.4, 0.7]

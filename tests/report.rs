@@ -3,7 +3,7 @@
 
 #[test]
 fn quick_report_writes_tables_csv_and_plot() {
-    use splitsum::measured::{Knob, Method, Part, Product, read_csv};
+    use splitsum::measured::{Knob, Method, Part, Quantity, read_csv};
     let dir = std::env::temp_dir().join(format!("splitsum-report-{}", std::process::id()));
     let env = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/studio.exr");
     runner::cli::run(["runner", "report", env, "--quick", "--out", dir.to_str().unwrap()]).expect("report");
@@ -18,15 +18,15 @@ fn quick_report_writes_tables_csv_and_plot() {
         assert!(html.contains(file) && md.contains(file), "{file} is on the page");
     }
     for (product, method) in [
-        (Product::BrdfTable, Method::Seed),
-        (Product::BrdfTable, Method::Defaults),
-        (Product::Prefilter, Method::Defaults),
-        (Product::Irradiance, Method::Defaults),
-        (Product::Irradiance, Method::Sh9),
-        (Product::ShadedColour, Method::Defaults),
-        (Product::ShadedColour, Method::Seed),
-        (Product::PrefilteredLookup, Method::Seed),
-        (Product::PrefilteredLookup, Method::Defaults),
+        (Quantity::BrdfTable, Method::Seed),
+        (Quantity::BrdfTable, Method::Defaults),
+        (Quantity::Prefilter, Method::Defaults),
+        (Quantity::Irradiance, Method::Defaults),
+        (Quantity::Irradiance, Method::Sh9),
+        (Quantity::ShadedColour, Method::Defaults),
+        (Quantity::ShadedColour, Method::Seed),
+        (Quantity::PrefilteredLookup, Method::Seed),
+        (Quantity::PrefilteredLookup, Method::Defaults),
     ] {
         for backend in ["gpu", "cpu"] {
             assert!(rows.iter().any(|r| r.product == product && r.method == method && r.backend == backend), "no {product:?} by {method:?} on {backend}");
@@ -37,17 +37,17 @@ fn quick_report_writes_tables_csv_and_plot() {
     }
     assert!(rows.iter().any(|r| r.method == Method::ExactIngredients && r.part == Part::SplitSum));
     assert!(rows.iter().any(|r| r.part == Part::SplitSum && r.backend == "gpu") && rows.iter().any(|r| r.part == Part::Model));
-    for r in rows.iter().filter(|r| r.product != Product::ShadingCost) {
+    for r in rows.iter().filter(|r| r.product != Quantity::ShadingCost) {
         assert!(r.mean_error.is_finite() && r.mean_error >= 0.0 && r.max_error >= r.mean_error, "{r:?}");
     }
     // The shading ladder: every rung's cost on both backends, its errors beside, its figure
     // and table on the page.
     for backend in ["gpu", "cpu"] {
         for fetches in [1, 2, 4, 8, 16] {
-            let cost = rows.iter().find(|r| r.product == Product::ShadingCost && r.backend == backend && r.fetches == Some(fetches));
+            let cost = rows.iter().find(|r| r.product == Quantity::ShadingCost && r.backend == backend && r.fetches == Some(fetches));
             assert!(cost.and_then(|r| r.ns_per_pixel).is_some_and(|ns| ns.is_finite() && ns >= 0.0), "{backend}, {fetches} fetches: {cost:?}");
             let method = if fetches == 1 { Method::Defaults } else { Method::Ladder };
-            assert!(rows.iter().any(|r| r.product == Product::ShadedColour && r.method == method && r.fetches == Some(fetches) && r.backend == backend));
+            assert!(rows.iter().any(|r| r.product == Quantity::ShadedColour && r.method == method && r.fetches == Some(fetches) && r.backend == backend));
         }
     }
     // The budget curve: every budget on both backends, each choice's estimate within its
@@ -55,7 +55,7 @@ fn quick_report_writes_tables_csv_and_plot() {
     for backend in ["gpu", "cpu"] {
         let chosen: Vec<(f64, f64)> = rows
             .iter()
-            .filter(|r| r.method == Method::TimeBudget && r.product == Product::ShadedColour && r.backend == backend && r.part == Part::Total && r.roughness_lo.is_none() && r.nv_hi.is_none())
+            .filter(|r| r.method == Method::TimeBudget && r.product == Quantity::ShadedColour && r.backend == backend && r.part == Part::Total && r.roughness_lo.is_none() && r.nv_hi.is_none())
             .filter_map(|r| Some((r.budget_s?, r.estimate_s?)))
             .collect();
         assert_eq!(chosen.len(), splitsum_report::accuracy::BUDGETS.len(), "{backend}: {chosen:?}");
@@ -71,7 +71,7 @@ fn quick_report_writes_tables_csv_and_plot() {
     // The table's error falls with its sample count (4 → 64) on both backends.
     for backend in ["gpu", "cpu"] {
         let errs: Vec<f64> =
-            rows.iter().filter(|r| r.product == Product::BrdfTable && r.knob == Knob::Samples && r.backend == backend).map(|r| r.mean_error).collect();
+            rows.iter().filter(|r| r.product == Quantity::BrdfTable && r.knob == Knob::Samples && r.backend == backend).map(|r| r.mean_error).collect();
         assert_eq!(errs.len(), 3);
         assert!(errs[0] > errs[2], "{backend}: {errs:?}");
     }
@@ -121,7 +121,7 @@ fn end_to_end_measure_of_a_constant_sky() {
     use splitsum::environment::Environment;
     use splitsum::settings::Settings;
     use splitsum::texture::Equirect;
-    use splitsum::measured::{Part, Product};
+    use splitsum::measured::{Part, Quantity};
     use splitsum_report::accuracy::{Method, Points};
     use splitsum_shaders::glam::Vec4;
     let env = Environment::Equirect(Equirect { width: 64, height: 32, texels: vec![Vec4::new(0.5, 1.0, 2.0, 1.0); 64 * 32] });
@@ -130,14 +130,14 @@ fn end_to_end_measure_of_a_constant_sky() {
     let points = Points::new(&source, 48, 32);
     let methods = [Method { kind: splitsum::measured::Method::Defaults, settings, flags: splitsum_shaders::shade::ShadeOptions::DEFAULT.flags }];
     let rows = splitsum_report::accuracy::measure(&splitsum::Backend::Cpu, &env, &methods, &points).unwrap();
-    let worst = |product: Product, part: Part| rows.iter().filter(|r| r.product == product && r.part == part).map(|r| r.max_error).fold(0.0f64, f64::max);
-    let bake = worst(Product::ShadedColour, Part::Bake);
-    let lookup = worst(Product::PrefilteredLookup, Part::Total);
-    let split = worst(Product::ShadedColour, Part::SplitSum);
+    let worst = |product: Quantity, part: Part| rows.iter().filter(|r| r.product == product && r.part == part).map(|r| r.max_error).fold(0.0f64, f64::max);
+    let bake = worst(Quantity::ShadedColour, Part::Bake);
+    let lookup = worst(Quantity::PrefilteredLookup, Part::Total);
+    let split = worst(Quantity::ShadedColour, Part::SplitSum);
     println!("constant sky: bake share max {bake:.2e}, lookup max {lookup:.2e}, split sum max {split:.2e}");
     assert!(bake < 5e-3 && lookup < 1e-5, "bake {bake:e}, lookup {lookup:e}");
     assert!(split.is_finite() && split > 0.0);
-    assert!(rows.iter().any(|r| r.product == Product::ShadedColour && r.time_ms.is_some_and(f64::is_finite)));
+    assert!(rows.iter().any(|r| r.product == Quantity::ShadedColour && r.time_ms.is_some_and(f64::is_finite)));
 }
 
 /// The measure over sets, quickly: the generated skies and the environments present
@@ -145,7 +145,7 @@ fn end_to_end_measure_of_a_constant_sky() {
 /// --quick, a folder that lacks the studio lights is refused before anything runs.
 #[test]
 fn the_measure_over_tuning_and_held_out_sets() {
-    use splitsum::measured::{Part, Product, Set, read_csv};
+    use splitsum::measured::{Part, Quantity, Set, read_csv};
     let dir = std::env::temp_dir().join(format!("splitsum-report-sets-{}", std::process::id()));
     let assets = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments");
     let env = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/studio.exr");
@@ -155,7 +155,7 @@ fn the_measure_over_tuning_and_held_out_sets() {
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
     for (set, env) in [(Set::Tuning, "city"), (Set::Tuning, "overcast sky"), (Set::HeldOut, "studio"), (Set::HeldOut, "sky, sun 10^6 at 65°")] {
         assert!(
-            rows.iter().any(|r| r.set == Some(set) && r.environment == env && r.product == Product::ShadedColour && r.part == Part::SplitSum),
+            rows.iter().any(|r| r.set == Some(set) && r.environment == env && r.product == Quantity::ShadedColour && r.part == Part::SplitSum),
             "{env} in the {set:?} set"
         );
     }

@@ -4,6 +4,7 @@
 //! constant environment), GPU against CPU, and a bake that leaves sheen out when nothing
 //! reads it. glTF-IBL-Sampler's own Charlie output is compared in `targets.rs`.
 
+use splitsum::Product;
 use rayon::prelude::*;
 use splitsum::Backend;
 use splitsum::texture::Cube;
@@ -240,7 +241,7 @@ fn sheen_shading_under_a_constant_sky_is_the_sheen_albedo() {
 fn a_sheen_grid_renders_the_same_on_gpu_and_cpu() {
     use splitsum_display::render::{GpuScene, ViewState, render_cpu};
     let env = support::small_display_bake();
-    assert!(env.sheen.layout.size > 1, "the display bake holds a sheen cube");
+    assert!(env.cube(Product::Sheen).layout.size > 1, "the display bake holds a sheen cube");
     let Backend::Gpu(gpu) = gpu() else { unreachable!() };
     let scene = GpuScene::new(gpu, &env);
     let view = ViewState { sheen_color: Vec3::new(1.0, 0.3, 0.6), sheen_ranges: (0.0, 1.0), base_color: Vec3::new(0.1, 0.1, 0.15), ..ViewState::default() };

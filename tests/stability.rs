@@ -3,6 +3,7 @@
 //! be finite; the BRDF table stays within [0, 1]; a constant environment stays constant.
 //! `docs/HAZARDS.md` lists each hazard with the rule the code applies.
 
+use splitsum::Product;
 use splitsum::Backend;
 use splitsum::texture::Cube;
 use splitsum_shaders::cubemap::CubeLayout;
@@ -238,19 +239,18 @@ fn extreme_environment_bakes_and_renders_finite() {
     for b in backends() {
         let baked = bake::bake(b, &env, &settings, Products::ALL).unwrap();
         let all = baked
-            .source
-            .as_ref()
+            .cube(Product::SourceCube)
             .unwrap()
             .texels
             .iter()
-            .chain(&baked.specular.as_ref().unwrap().texels)
-            .chain(&baked.irradiance.as_ref().unwrap().texels)
-            .chain(&baked.sheen.as_ref().expect("Products::ALL bakes sheen").texels);
+            .chain(&baked.cube(Product::Specular).unwrap().texels)
+            .chain(&baked.cube(Product::Irradiance).unwrap().texels)
+            .chain(&baked.cube(Product::Sheen).expect("Products::ALL bakes sheen").texels);
         for t in all {
             assert!(t.is_finite(), "{}: {t}", b.describe());
         }
-        assert!(baked.sh9.as_ref().unwrap().radiance.iter().flatten().all(|v| v.is_finite()));
-        assert!(baked.lut.as_ref().unwrap().texels.iter().all(|t| t.is_finite()));
+        assert!(baked.sh9().unwrap().radiance.iter().flatten().all(|v| v.is_finite()));
+        assert!(baked.table(Product::BrdfTable).unwrap().texels.iter().all(|t| t.is_finite()));
     }
     // Rendered on the GPU in linear radiance, with lights of 10⁶ and mirror spheres.
     let baked = bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();

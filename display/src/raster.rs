@@ -4,6 +4,7 @@
 //! texture filtering (bilinear, repeat, mip 0; sRGB decoded before filtering), then the
 //! same `surface::material` and `scene::shade_point` the fragment shader runs.
 
+use splitsum::Product;
 use crate::model::{Model, Texture};
 use rayon::prelude::*;
 use splitsum::bake::BakedEnvironment;
@@ -82,7 +83,7 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
     colour.par_chunks_mut(w).zip(depth.par_chunks_mut(w)).enumerate().for_each(|(y, (crow, drow))| {
         for x in 0..w {
             let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            let (c, d) = scene::radiance_depth(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &env.sheen.texels, &env.sheen_tables.texels, px);
+            let (c, d) = scene::radiance_depth(frame, env.cube(Product::SourceCube).level(0), &env.cube(Product::Specular).texels, &env.cube(Product::Irradiance).texels, &env.table(Product::BrdfTable).texels, &env.cube(Product::Sheen).texels, &env.table(Product::SheenTables).texels, px);
             crow[x] = c;
             drow[x] = d;
         }
@@ -178,11 +179,11 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
         *c = scene::shade_point(
             frame,
             prim.material.options,
-            &env.specular.texels,
-            &env.irradiance.texels,
-            &env.lut.texels,
-            &env.sheen.texels,
-            &env.sheen_tables.texels,
+            &env.cube(Product::Specular).texels,
+            &env.cube(Product::Irradiance).texels,
+            &env.table(Product::BrdfTable).texels,
+            &env.cube(Product::Sheen).texels,
+            &env.table(Product::SheenTables).texels,
             &m,
             position,
             n,

@@ -7,6 +7,7 @@
 //!   (per pixel: the normal and the view, six f32), bakes `<slug>.exr` with the defaults
 //!   and writes `DIR/<slug>_r<r>_k<K>.f32`: per pixel the RGB that splitsum's shading gives a
 //!   white metal of roughness `r` with `K` fetches (the one fetch is the default).
+use splitsum::Product;
 use splitsum::backend::{Backend, BackendKind};
 use splitsum::settings::Settings;
 use splitsum_report::measurement::Set;
@@ -63,7 +64,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         let mut out = Vec::with_capacity(raw.len() / 2);
                         for p in raw.chunks_exact(6) {
                             let (n, v) = (Vec3::new(p[0], p[1], p[2]), Vec3::new(p[3], p[4], p[5]));
-                            let sample = shade::ibl_sample(shape, &baked.specular.texels, &baked.irradiance.texels, &baked.lut.texels, opts, &m, n, v);
+                            let sample = shade::ibl_sample(shape, &baked.cube(Product::Specular).texels, &baked.cube(Product::Irradiance).texels, &baked.table(Product::BrdfTable).texels, opts, &m, n, v);
                             let c = shade::ibl(opts, &m, n, v, sample);
                             out.extend([c.x, c.y, c.z]);
                         }

@@ -24,7 +24,8 @@
 //! - (c) *model*: the full integral with the method's masking term against the truth
 //!   (Smith–Schlick against exact Smith).
 
-use crate::measurement::{Knob, Measurement, Method as Kind, Metric, Part, Product, arr, rel, rel64};
+use splitsum::Product;
+use crate::measurement::{Knob, Measurement, Method as Kind, Metric, Part, Quantity, arr, rel, rel64};
 use rayon::prelude::*;
 use splitsum::backend::Backend;
 use splitsum::bake;
@@ -285,7 +286,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
         }
         let (_, baked, ms) = last.as_ref().expect("baked above");
         let ms = *ms;
-        let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
+        let (spec, irr, table, shape) = (baked.cube(Product::Specular), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
         let opts = method.options();
         let read = read_index(opts.flags);
         let correlated = usize::from(method.settings.lut_masking.unwrap_or(method.settings.lut_method.default_masking()) == Masking::SmithCorrelated);
@@ -312,7 +313,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             })
             .collect();
         let ladder = method.kind == Kind::Ladder;
-        let row = |product: Product, errors: &[f64]| Measurement {
+        let row = |product: Quantity, errors: &[f64]| Measurement {
             samples: Some(method.settings.samples),
             fetches: Some(opts.fetches()),
             knob: if ladder { Knob::Fetches } else { Knob::Samples },
@@ -323,9 +324,9 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
         let parts = if ladder { 1 } else { 4 };
         for k in 0..parts {
             let all: Vec<f64> = per_point.iter().map(|p| p.parts[k].1).collect();
-            // The ladder costs shading time, not bake time (`Product::ShadingCost`).
+            // The ladder costs shading time, not bake time (`Quantity::ShadingCost`).
             let time_ms = (k == 0 && !ladder).then_some(ms);
-            rows.push(Measurement { part: per_point[0].parts[k].0, time_ms, ..row(Product::ShadedColour, &all) });
+            rows.push(Measurement { part: per_point[0].parts[k].0, time_ms, ..row(Quantity::ShadedColour, &all) });
         }
         // By roughness band, then by view band, each split into its parts.
         let mut roughness: Vec<(f32, f32)> = per_point.iter().map(|p| roughness_band(p.roughness)).collect();
@@ -338,11 +339,11 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             let part = per_point[0].parts[k].0;
             for &(lo, hi) in &roughness {
                 let e: Vec<f64> = per_point.iter().filter(|p| roughness_band(p.roughness) == (lo, hi)).map(|p| p.parts[k].1).collect();
-                rows.push(Measurement { part, roughness_lo: Some(lo), roughness_hi: Some(hi), ..row(Product::ShadedColour, &e) });
+                rows.push(Measurement { part, roughness_lo: Some(lo), roughness_hi: Some(hi), ..row(Quantity::ShadedColour, &e) });
             }
             for &(lo, hi) in &views {
                 let e: Vec<f64> = per_point.iter().filter(|p| view_band(p.n_dot_v) == (lo, hi)).map(|p| p.parts[k].1).collect();
-                rows.push(Measurement { part, nv_lo: Some(lo), nv_hi: Some(hi), ..row(Product::ShadedColour, &e) });
+                rows.push(Measurement { part, nv_lo: Some(lo), nv_hi: Some(hi), ..row(Quantity::ShadedColour, &e) });
             }
         }
         if ladder {
@@ -358,7 +359,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             })
             .collect();
         let all: Vec<f64> = lookups.iter().map(|l| l.2).collect();
-        rows.push(Measurement { time_ms: Some(ms), ..row(Product::PrefilteredLookup, &all) });
+        rows.push(Measurement { time_ms: Some(ms), ..row(Quantity::PrefilteredLookup, &all) });
         for &lo in &ROUGHNESS_BANDS {
             let band = roughness_band(lo);
             for near in [true, false] {
@@ -368,7 +369,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
                         roughness_lo: Some(band.0),
                         roughness_hi: Some(band.1),
                         near_sun: Some(near),
-                        ..row(Product::PrefilteredLookup, &e)
+                        ..row(Quantity::PrefilteredLookup, &e)
                     });
                 }
             }

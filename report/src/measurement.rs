@@ -5,7 +5,7 @@
 use splitsum_reference as reference;
 use splitsum_shaders::glam::Vec3;
 
-pub use splitsum::measured::{Knob, Measurement, Method, Metric, Part, Product, Set};
+pub use splitsum::measured::{Knob, Measurement, Method, Metric, Part, Quantity, Set};
 
 /// The backend rows are measured on: its kind's name (`gpu`, `cpu`) and its description.
 pub struct Device {
@@ -21,7 +21,7 @@ impl Device {
     }
 
     /// A row of `product` by `method` on this device.
-    pub fn row(&self, product: Product, method: Method, errors: &[f64], metric: Metric) -> Measurement {
+    pub fn row(&self, product: Quantity, method: Method, errors: &[f64], metric: Metric) -> Measurement {
         Measurement { backend: self.engine.into(), device: self.description.clone(), ..Measurement::of(product, method, errors, metric) }
     }
 }

@@ -4,7 +4,7 @@
 //! `report.html`, `report.md`, `report.csv` and the figures ([`crate::plot`],
 //! [`crate::surface`]). Measuring is [`crate::report`]'s.
 
-use crate::measurement::{Knob, Measurement, Method, Part, Product};
+use crate::measurement::{Knob, Measurement, Method, Part, Quantity};
 use crate::sweep::Sweep;
 use crate::surface::ErrorMap;
 use splitsum::backend::Backend;
@@ -22,10 +22,10 @@ pub fn panel(r: &Measurement) -> Option<String> {
         return None;
     }
     match (r.product, r.knob) {
-        (Product::Prefilter, Knob::Samples) => Some(format!("prefiltered cube, r = {:.2}", r.roughness_lo?)),
-        (Product::Prefilter, _) => None,
-        (Product::ShadedColour, Knob::Quality) => Some(format!("shaded colour, quality levels, n·v in ({}, {}]", r.nv_lo?, r.nv_hi?)),
-        (Product::ShadedColour | Product::PrefilteredLookup, _) => Some(format!("{}, end to end", r.product.title())),
+        (Quantity::Prefilter, Knob::Samples) => Some(format!("prefiltered cube, r = {:.2}", r.roughness_lo?)),
+        (Quantity::Prefilter, _) => None,
+        (Quantity::ShadedColour, Knob::Quality) => Some(format!("shaded colour, quality levels, n·v in ({}, {}]", r.nv_lo?, r.nv_hi?)),
+        (Quantity::ShadedColour | Quantity::PrefilteredLookup, _) => Some(format!("{}, end to end", r.product.title())),
         (p, _) => Some(p.title().to_string()),
     }
 }
@@ -98,7 +98,7 @@ type Table = (String, [&'static str; 8], Vec<[String; 8]>);
 
 /// The report's tables: one per product, rows in measurement order.
 fn tables(rows: &[Measurement]) -> Vec<Table> {
-    let mut products: Vec<Product> = rows.iter().filter(|r| r.set.is_none() && r.product != Product::ShadingCost).map(|r| r.product).collect();
+    let mut products: Vec<Quantity> = rows.iter().filter(|r| r.set.is_none() && r.product != Quantity::ShadingCost).map(|r| r.product).collect();
     products.sort();
     products.dedup();
     let header = ["method", "backend", "setting", "band", "part", "time (ms)", "mean error", "max error"];
@@ -165,8 +165,8 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
         let cells = methods
             .iter()
             .map(|&m| {
-                let shaded = |part: Part| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == part && no_band(r)));
-                let view = |hi: f32| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
+                let shaded = |part: Part| over_environments(of(m).filter(|r| r.product == Quantity::ShadedColour && r.part == part && no_band(r)));
+                let view = |hi: f32| over_environments(of(m).filter(|r| r.product == Quantity::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
                 [
                     match m.2 {
                         1 => format!("{}, {} samples", m.0.title(), m.1),
@@ -178,7 +178,7 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
                     view(0.6),
                     view(1.0),
                     shaded(Part::Bake),
-                    over_environments(of(m).filter(|r| r.product == Product::PrefilteredLookup && no_band(r))),
+                    over_environments(of(m).filter(|r| r.product == Quantity::PrefilteredLookup && no_band(r))),
                 ]
             })
             .collect();
@@ -192,8 +192,8 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
         .iter()
         .map(|&(env, set)| {
             let of = |m: Key| set_rows.iter().copied().filter(move |r| r.environment == env && key(r) == m);
-            let shaded = |m, part: Part| over_environments(of(m).filter(|r| r.product == Product::ShadedColour && r.part == part && no_band(r)));
-            let view = |hi: f32| over_environments(of(defaults).filter(|r| r.product == Product::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
+            let shaded = |m, part: Part| over_environments(of(m).filter(|r| r.product == Quantity::ShadedColour && r.part == part && no_band(r)));
+            let view = |hi: f32| over_environments(of(defaults).filter(|r| r.product == Quantity::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
             [
                 env.to_string(),
                 set.title().to_string(),
@@ -224,7 +224,7 @@ pub fn rung_method(fetches: u32) -> Method {
 /// The rungs of the ladder present in `rows`, in order.
 fn rungs(rows: &[Measurement]) -> Vec<u32> {
     let mut k: Vec<u32> =
-        rows.iter().filter(|r| r.product == Product::ShadingCost).filter_map(|r| r.fetches.filter(|&k| r.method == rung_method(k))).collect();
+        rows.iter().filter(|r| r.product == Quantity::ShadingCost).filter_map(|r| r.fetches.filter(|&k| r.method == rung_method(k))).collect();
     k.sort();
     k.dedup();
     k
@@ -232,7 +232,7 @@ fn rungs(rows: &[Measurement]) -> Vec<u32> {
 
 /// The cost per shaded pixel of `method` with `fetches` on the backend `engine`.
 fn cost_of(rows: &[Measurement], method: Method, fetches: u32, engine: &str) -> Option<f64> {
-    rows.iter().find(|r| r.product == Product::ShadingCost && r.method == method && r.fetches == Some(fetches) && r.backend == engine).and_then(|r| r.ns_per_pixel)
+    rows.iter().find(|r| r.product == Quantity::ShadingCost && r.method == method && r.fetches == Some(fetches) && r.backend == engine).and_then(|r| r.ns_per_pixel)
 }
 
 /// The shaded colour's rows of `method` with `fetches` at the default sample count, part
@@ -240,7 +240,7 @@ fn cost_of(rows: &[Measurement], method: Method, fetches: u32, engine: &str) -> 
 fn method_rows(rows: &[Measurement], method: Method, fetches: u32) -> impl Iterator<Item = &Measurement> {
     let samples = Settings::default().samples;
     rows.iter().filter(move |r| {
-        r.product == Product::ShadedColour
+        r.product == Quantity::ShadedColour
             && r.part == Part::Total
             && r.method == method
             && r.fetches == Some(fetches)
@@ -263,7 +263,7 @@ fn ladder_table(rows: &[Measurement]) -> Option<Table> {
     if rungs.is_empty() {
         return None;
     }
-    let first = rows.iter().find(|r| r.product == Product::ShadedColour && r.set.is_none() && !r.backend.is_empty()).map(|r| r.backend.clone());
+    let first = rows.iter().find(|r| r.product == Quantity::ShadedColour && r.set.is_none() && !r.backend.is_empty()).map(|r| r.backend.clone());
     // The rungs, then the quality mode below mip 1 (`--filtered`, one fetch but sixteen
     // samples where it applies) for its cost beside theirs.
     let mut lines: Vec<(String, Method, u32)> = rungs.iter().map(|&k| (format!("{k}"), rung_method(k), k)).collect();
@@ -336,7 +336,7 @@ pub fn ladder_panels(rows: &[Measurement]) -> Vec<crate::plot::LadderPanel> {
 fn budget_rows(rows: &[Measurement], band: Option<f32>) -> impl Iterator<Item = &Measurement> {
     rows.iter().filter(move |r| {
         r.method == Method::TimeBudget
-            && r.product == Product::ShadedColour
+            && r.product == Quantity::ShadedColour
             && r.part == Part::Total
             && r.set.is_none()
             && r.roughness_lo.is_none()

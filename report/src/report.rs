@@ -15,9 +15,10 @@
 //! repository), `report.csv` (the typed rows, `splitsum::measured`), `error_vs_time.svg`
 //! (small multiples, [`crate::plot`]) and the error on surfaces ([`crate::surface`]).
 
+use splitsum::Product;
 use crate::pages::write_outputs;
 use crate::sweep::{Sets, Sweep};
-use crate::measurement::{Device, Knob, Measurement, Method, Metric, Part, Product, arr, rel};
+use crate::measurement::{Device, Knob, Measurement, Method, Metric, Part, Quantity, arr, rel};
 use rayon::prelude::*;
 use splitsum::backend::Backend;
 use splitsum::bake;
@@ -50,7 +51,7 @@ fn directions(n: u32) -> Vec<Vec3> {
 
 /// Runs the report's sweeps of `env` on `backends` (and the measure over `sets`, if
 /// given, on the first backend), writes the files into `dir` with the shading ladder's
-/// `costs` (`Product::ShadingCost` rows, timed by the renderer's owner) beside its errors,
+/// `costs` (`Quantity::ShadingCost` rows, timed by the renderer's owner) beside its errors,
 /// and returns the measurements.
 pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, sets: Option<&Sets>, costs: &[Measurement], dir: &Path) -> Result<Vec<Measurement>> {
     if let Some(s) = sets
@@ -222,7 +223,7 @@ impl References {
             .iter()
             .map(|&(lo, hi)| {
                 let errors: Vec<f64> = self.shading.iter().filter(|p| in_view(p, (lo, hi))).map(|p| rel(p.exact_split, p.full)).collect();
-                let row = Measurement::of(Product::ShadedColour, Method::ExactIngredients, &errors, Metric::RelativeLuminance);
+                let row = Measurement::of(Quantity::ShadedColour, Method::ExactIngredients, &errors, Metric::RelativeLuminance);
                 Measurement { part: Part::SplitSum, nv_lo: Some(lo), nv_hi: Some(hi), ..row }
             })
             .collect()
@@ -251,12 +252,12 @@ fn lut_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References) -> 
     for &n in &sweep.samples {
         let (table, ms) = timed(|| backend.brdf_lut(sweep.lut_size, n))?;
         let errors = albedo_errors(table.texels.iter().copied(), refs.lut.iter().copied());
-        rows.push(Measurement { knob: Knob::Samples, samples: Some(n), size, time_ms: Some(ms), ..b.row(Product::BrdfTable, Method::Seed, &errors, Metric::RelativeAlbedo) });
+        rows.push(Measurement { knob: Knob::Samples, samples: Some(n), size, time_ms: Some(ms), ..b.row(Quantity::BrdfTable, Method::Seed, &errors, Metric::RelativeAlbedo) });
     }
     // The deterministic quadrature (the default table), on the same texels.
     let (table, ms) = timed(|| backend.brdf_table(sweep.lut_size, Masking::SmithSchlick))?;
     let errors = albedo_errors(table.texels.iter().copied(), refs.lut.iter().copied());
-    rows.push(Measurement { size, time_ms: Some(ms), ..b.row(Product::BrdfTable, Method::Defaults, &errors, Metric::RelativeAlbedo) });
+    rows.push(Measurement { size, time_ms: Some(ms), ..b.row(Quantity::BrdfTable, Method::Defaults, &errors, Metric::RelativeAlbedo) });
     let n = *sweep.samples.last().expect("samples");
     for &size in &sweep.lut_sizes {
         let (table, ms) = timed(|| backend.brdf_lut(size, n))?;
@@ -266,7 +267,7 @@ fn lut_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References) -> 
             samples: Some(n),
             size: Some(size),
             time_ms: Some(ms),
-            ..b.row(Product::BrdfTableLookup, Method::Seed, &errors, Metric::RelativeAlbedo)
+            ..b.row(Quantity::BrdfTableLookup, Method::Seed, &errors, Metric::RelativeAlbedo)
         });
     }
     Ok(rows)
@@ -284,7 +285,7 @@ fn prefilter_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &Reference
             .zip(&refs.prefilter[m])
             .map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, layout, 0, d).truncate(), *r))
             .collect();
-        let row = b.row(Product::Prefilter, Method::Defaults, &errors, Metric::RelativeLuminance);
+        let row = b.row(Quantity::Prefilter, Method::Defaults, &errors, Metric::RelativeLuminance);
         let r = Some(roughness[m]);
         rows.push(Measurement { knob, samples: Some(n), bias: Some(bias), size: Some(size), roughness_lo: r, roughness_hi: r, time_ms: Some(ms), ..row });
         Ok(())
@@ -319,7 +320,7 @@ fn irradiance_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &Referenc
             .zip(&refs.irradiance)
             .map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, cube.layout, 0, d).truncate(), *r))
             .collect();
-        let row = b.row(Product::Irradiance, Method::Defaults, &errors, Metric::RelativeLuminance);
+        let row = b.row(Quantity::Irradiance, Method::Defaults, &errors, Metric::RelativeLuminance);
         rows.push(Measurement { knob: Knob::SourceSize, source_size: Some(s), size: Some(sweep.irradiance_size), time_ms: Some(ms), ..row });
     }
     for &s in &sweep.sh_sources {
@@ -327,7 +328,7 @@ fn irradiance_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &Referenc
         let (sh, ms) = timed(|| backend.sh9(source, level))?;
         let coeffs = sh.as_vec4();
         let errors: Vec<f64> = refs.irradiance_dirs.iter().zip(&refs.irradiance).map(|(&d, r)| rel(sh9_irradiance(&coeffs, d), *r)).collect();
-        let row = b.row(Product::Irradiance, Method::Sh9, &errors, Metric::RelativeLuminance);
+        let row = b.row(Quantity::Irradiance, Method::Sh9, &errors, Metric::RelativeLuminance);
         rows.push(Measurement { knob: Knob::SourceSize, source_size: Some(s), time_ms: Some(ms), ..row });
     }
     Ok(rows)
@@ -337,7 +338,7 @@ fn shaded_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, 
     let mut rows = Vec::new();
     for settings in &sweep.qualities {
         let (baked, ms) = timed(|| bake::bake_for_display(backend, env, settings))?;
-        let (spec, irr, table, shape) = (&baked.specular, &baked.irradiance, &baked.lut, baked.shape());
+        let (spec, irr, table, shape) = (baked.cube(Product::Specular), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
         for &(lo, hi) in &VIEWS {
             let errors: Vec<f64> = refs
                 .shading
@@ -348,7 +349,7 @@ fn shaded_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, 
                     rel(shade::ibl(ShadeOptions::DEFAULT, &p.material, p.n, p.v, s), p.full)
                 })
                 .collect();
-            let row = b.row(Product::ShadedColour, Method::Defaults, &errors, Metric::RelativeLuminance);
+            let row = b.row(Quantity::ShadedColour, Method::Defaults, &errors, Metric::RelativeLuminance);
             let (samples, size) = (Some(settings.samples), Some(settings.size));
             rows.push(Measurement { knob: Knob::Quality, samples, size, nv_lo: Some(lo), nv_hi: Some(hi), time_ms: Some(ms), ..row });
         }

@@ -7,6 +7,7 @@
 //! Orthographic view along −z (`v = +z` everywhere), so the rim of each sphere is its
 //! grazing view: the split sum's own error shows there.
 
+use splitsum::Product;
 use crate::measurement::{arr, rel};
 use rayon::prelude::*;
 use splitsum::bake::BakedEnvironment;
@@ -94,7 +95,7 @@ pub fn error_map(baked: &BakedEnvironment, env: &reference::Environment) -> Erro
     let shaded: Vec<(Vec3, [f64; 3])> = points
         .par_iter()
         .map(|(_, _, m, n)| {
-            let s = shade::ibl_sample(shape, &baked.specular.texels, &baked.irradiance.texels, &baked.lut.texels, opts, m, *n, v);
+            let s = shade::ibl_sample(shape, &baked.cube(Product::Specular).texels, &baked.cube(Product::Irradiance).texels, &baked.table(Product::BrdfTable).texels, opts, m, *n, v);
             let got = shade::ibl(opts, m, *n, v, s);
             let want = env.shade(arr(*n), arr(v), arr(m.base_color), m.metallic as f64, m.roughness as f64, reference::Smith::Correlated);
             (got, want)

@@ -9,11 +9,13 @@ use crate::cost;
 use crate::estimate::Estimator;
 use crate::environment::Environment;
 use crate::error::{Error, Result};
-use crate::settings::{InputShape, Job, Products, Settings, Step};
+use crate::product::{Item, Layout};
+use crate::settings::{InputShape, Job, Product, Products, Settings};
 use crate::texture::{Cube, Lut, Sh9};
 use serde::Serialize;
 use splitsum_shaders::cubemap::{self, CubeLayout};
-use splitsum_shaders::prefilter::{Lobe, RoughnessMapping};
+use splitsum_shaders::prefilter::RoughnessMapping;
+use std::collections::BTreeMap;
 use splitsum_shaders::shade::EnvironmentShape;
 use web_time::Instant;
 
@@ -21,7 +23,7 @@ use web_time::Instant;
 #[derive(Clone, Debug, Serialize)]
 pub struct Timing {
     /// The step.
-    pub step: Step,
+    pub step: Product,
     /// Seconds.
     pub seconds: f64,
     /// The estimate shown as the step started (`crate::estimate`), in seconds.
@@ -31,27 +33,70 @@ pub struct Timing {
 
 /// The products of a bake: as a backend made them (`Made<K::Texels>`: host texels, or
 /// device buffers), or read into host memory ([`Baked`]). Each is present where the job
-/// asked for it.
+/// asked for it (the source cube: unless a bake read textures back and nothing kept it).
 pub struct Made<C, L = C> {
-    /// The source cube with its mips (always made; absent where a bake read textures back
-    /// and nothing kept it).
-    pub source: Option<C>,
-    /// The specular cube (`Job::specular_layout`).
-    pub specular: Option<C>,
-    /// The irradiance cube (`E/π`).
-    pub irradiance: Option<C>,
-    /// SH9 radiance coefficients.
-    pub sh9: Option<Sh9>,
-    /// The BRDF table, `(A, B, 0, 0)` per texel on a backend.
-    pub lut: Option<L>,
-    /// The sheen cube (Charlie-prefiltered radiance; `Job::specular_layout`, sheen
-    /// roughness `Job::sheen_roughness_per_mip`).
-    pub sheen: Option<C>,
-    /// The sheen tables, `(Charlie table, sheen albedo, 0, 0)` per texel on a backend
-    /// (`crate::table::SHEEN_TABLE_SIZE`²).
-    pub sheen_tables: Option<L>,
+    items: BTreeMap<Product, Item<C, L>>,
     /// Wall time of each step.
     pub timings: Vec<Timing>,
+}
+
+impl<C, L> Made<C, L> {
+    internal! {
+        /// Nothing made yet.
+        pub fn new(timings: Vec<Timing>) -> Self {
+            Self { items: BTreeMap::new(), timings }
+        }
+    }
+
+    /// The cube `p` (`Product::layout`), if made.
+    pub fn cube(&self, p: Product) -> Option<&C> {
+        match self.items.get(&p) {
+            Some(Item::Cube(c)) => Some(c),
+            _ => None,
+        }
+    }
+
+    /// The table `p`, if made.
+    pub fn table(&self, p: Product) -> Option<&L> {
+        match self.items.get(&p) {
+            Some(Item::Table(t)) => Some(t),
+            _ => None,
+        }
+    }
+
+    /// The SH9 coefficients, if made.
+    pub fn sh9(&self) -> Option<&Sh9> {
+        match self.items.get(&Product::Sh9) {
+            Some(Item::Coefficients(c)) => Some(c.as_ref()),
+            _ => None,
+        }
+    }
+
+    internal! {
+        /// Adds (or replaces) product `p`.
+        pub fn insert(&mut self, p: Product, item: Item<C, L>) {
+            self.items.insert(p, item);
+        }
+    }
+
+    internal! {
+        /// Takes product `p` out.
+        pub fn take(&mut self, p: Product) -> Option<Item<C, L>> {
+            self.items.remove(&p)
+        }
+    }
+
+    /// The products made, in the order of [`Product::ALL`].
+    pub fn products(&self) -> impl Iterator<Item = Product> + '_ {
+        self.items.keys().copied()
+    }
+
+    internal! {
+        /// Each product made, in the order of [`Product::ALL`].
+        pub fn items(&self) -> impl Iterator<Item = (Product, &Item<C, L>)> {
+            self.items.iter().map(|(p, i)| (*p, i))
+        }
+    }
 }
 
 /// The results of a bake, in host memory.
@@ -59,7 +104,7 @@ pub type Baked = Made<Cube, Lut>;
 
 /// Runs `step` of `job` on `k` with its progress and estimate shown, records its wall time
 /// (until the backend has finished it) beside the estimate, and teaches `est` by it.
-fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, step: Step, job: &Job, est: &mut Estimator, f: impl FnOnce() -> Result<T>) -> Result<T> {
+fn timed<K: Kernels, T>(k: &K, timings: &mut Vec<Timing>, step: Product, job: &Job, est: &mut Estimator, f: impl FnOnce() -> Result<T>) -> Result<T> {
     let estimate = est.step(job, step);
     let _progress = crate::progress::step(step.name(), Some(estimate));
     let start = Instant::now();
@@ -129,70 +174,67 @@ pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, job: &Job)
 }
 
 /// Bakes the products of `job` from a source cube already on backend `k`, each step
-/// estimated by `est`.
-pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout, job: &Job, est: &mut Estimator, mut timings: Vec<Timing>) -> Result<Made<K::Texels>> {
-    let p = job.products;
-    let specular = if p.specular {
-        let pf = prefilter_of(job, Lobe::Ggx);
-        Some(timed(k, &mut timings, Step::Specular, job, est, || k.prefilter(&source, source_layout, &pf))?)
-    } else {
-        None
-    };
-    let irradiance = if p.irradiance {
-        Some(timed(k, &mut timings, Step::Irradiance, job, est, || k.irradiance(&source, source_layout, job.irradiance_level(), job.irradiance_size))?)
-    } else {
-        None
-    };
-    let sh9 = if p.sh9 { Some(timed(k, &mut timings, Step::Sh9, job, est, || k.sh9(&source, source_layout, job.sh_level()))?) } else { None };
-    let lut = if p.lut {
-        // A constant (`crate::table`): embedded or computed once per process, then uploaded.
-        Some(timed(k, &mut timings, Step::BrdfTable, job, est, || k.upload("brdf table", &crate::table::texels(crate::table::TableKey::of(job))?))?)
-    } else {
-        None
-    };
-    let (sheen, sheen_tables) = if p.sheen {
-        let pf = prefilter_of(job, Lobe::Charlie);
-        let cube = timed(k, &mut timings, Step::Sheen, job, est, || k.prefilter(&source, source_layout, &pf))?;
-        // Constants, as the BRDF table: computed once per process, then uploaded.
-        let tables = timed(k, &mut timings, Step::SheenTables, job, est, || k.upload("sheen tables", &crate::table::sheen_texels()))?;
-        (Some(cube), Some(tables))
-    } else {
-        (None, None)
-    };
-    Ok(Made { source: Some(source), specular, irradiance, sh9, lut, sheen, sheen_tables, timings })
+/// estimated by `est`: every product of `job.products` after the source cube, in the order
+/// of [`Product::ALL`] (`Product::make`).
+pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout, job: &Job, est: &mut Estimator, timings: Vec<Timing>) -> Result<Made<K::Texels>> {
+    let mut made = Made::new(timings);
+    for p in job.products.iter().filter(|p| *p != Product::SourceCube) {
+        let item = timed(k, &mut made.timings, p, job, est, || make_product(k, p, &source, source_layout, job))?;
+        made.insert(p, item);
+    }
+    made.insert(Product::SourceCube, Item::Cube(source));
+    Ok(made)
 }
 
-/// What the prefilter of `job`'s `lobe` cube computes: the specular cube (GGX) or the
-/// sheen cube (Charlie), with the same layout and samples per mip.
-fn prefilter_of(job: &Job, lobe: Lobe) -> Prefilter<'_> {
-    let (roughness, levels, exact) = match lobe {
-        Lobe::Ggx => (&job.roughness_per_mip, &job.levels, &job.exact_levels),
-        Lobe::Charlie => (&job.sheen_roughness_per_mip, &job.sheen_levels, &job.sheen_exact_levels),
-    };
-    Prefilter { lobe, layout: job.specular_layout(), roughness, levels, samples: &job.samples_per_mip, exact, lod_bias: job.lod_bias }
+/// Makes product `p` of `job` on backend `k` from the source cube `source` (made first,
+/// by [`source_cube`]): a prefiltered cube of any lobe by the backend's prefilter.
+fn make_product<K: Kernels>(k: &K, p: Product, source: &K::Texels, source_layout: CubeLayout, job: &Job) -> Result<Item<K::Texels>> {
+    Ok(match p {
+        p if p.lobe().is_some() => Item::Cube(k.prefilter(source, source_layout, &prefilter(job, p))?),
+        Product::Irradiance => Item::Cube(k.irradiance(source, source_layout, job.irradiance_level(), job.irradiance_size)?),
+        Product::Sh9 => Item::Coefficients(Box::new(k.sh9(source, source_layout, job.sh_level())?)),
+        // Constants (`crate::table`): embedded or computed once per process, then uploaded.
+        Product::BrdfTable => Item::Table(k.upload("brdf table", &crate::table::texels(crate::table::TableKey::of(job))?)?),
+        Product::SheenTables => Item::Table(k.upload("sheen tables", &crate::table::sheen_texels())?),
+        Product::SourceCube | Product::Specular | Product::Sheen => unreachable!("the source cube is made first, by source_cube"),
+    })
+}
+
+/// What the backends' prefilter computes for the prefiltered cube `p` of `job`.
+pub fn prefilter(job: &Job, p: Product) -> Prefilter<'_> {
+    let cube = &job.prefiltered[&p];
+    Prefilter {
+        lobe: p.lobe().expect("a prefiltered cube has a lobe"),
+        layout: job.specular_layout(),
+        roughness: &cube.roughness_per_mip,
+        levels: &cube.levels,
+        samples: &job.samples_per_mip,
+        exact: &cube.exact_levels,
+        lod_bias: job.lod_bias,
+    }
 }
 
 /// Bakes `job` from `env` on backend `k`, leaving the products there; each step
 /// estimated by `est`.
 pub fn make<K: Kernels>(k: &K, est: &mut Estimator, env: &Environment, job: &Job) -> Result<Made<K::Texels>> {
     let mut timings = Vec::new();
-    let (source, layout) = timed(k, &mut timings, Step::SourceCube, job, est, || source_cube(k, env, job))?;
+    let (source, layout) = timed(k, &mut timings, Product::SourceCube, job, est, || source_cube(k, env, job))?;
     self::products(k, source, layout, job, est, timings)
 }
 
-/// `made` read into host memory.
+/// `made` read into host memory, each product in its `Product::layout`.
 pub fn read<K: Kernels>(k: &K, made: Made<K::Texels>, job: &Job) -> Result<Baked> {
-    let cube = |layout: CubeLayout, t: &K::Texels| -> Result<Cube> { Ok(Cube { layout, texels: k.read(t)? }) };
-    Ok(Baked {
-        source: made.source.as_ref().map(|t| cube(job.source_layout(), t)).transpose()?,
-        specular: made.specular.as_ref().map(|t| cube(job.specular_layout(), t)).transpose()?,
-        irradiance: made.irradiance.as_ref().map(|t| cube(job.irradiance_layout(), t)).transpose()?,
-        sh9: made.sh9,
-        lut: made.lut.as_ref().map(|t| -> Result<Lut> { Ok(Lut::from_texels(job.lut_size, &k.read(t)?)) }).transpose()?,
-        sheen: made.sheen.as_ref().map(|t| cube(job.specular_layout(), t)).transpose()?,
-        sheen_tables: made.sheen_tables.as_ref().map(|t| -> Result<Lut> { Ok(Lut::from_texels(crate::table::SHEEN_TABLE_SIZE, &k.read(t)?)) }).transpose()?,
-        timings: made.timings,
-    })
+    let mut baked = Baked::new(made.timings);
+    for (p, item) in made.items {
+        let host = match (item, job.layout(p)) {
+            (Item::Cube(t), Layout::Cube(layout)) => Item::Cube(Cube { layout, texels: k.read(&t)? }),
+            (Item::Table(t), Layout::Table(size)) => Item::Table(Lut::from_texels(size, &k.read(&t)?)),
+            (Item::Coefficients(c), _) => Item::Coefficients(c),
+            _ => unreachable!("{p} was made in its own layout"),
+        };
+        baked.insert(p, host);
+    }
+    Ok(baked)
 }
 
 /// Bakes `products` of `env` with `settings` on `backend`, into host memory.
@@ -221,65 +263,79 @@ pub fn empty_table() -> Lut {
 }
 
 impl Baked {
-    /// What a renderer reads, with stand-ins for the products not baked (nothing reads
-    /// them) and the source cube's level 0 (the sharp sky).
-    pub fn into_display(self, mapping: RoughnessMapping) -> BakedEnvironment {
-        let source = self.source.as_ref().map_or_else(empty_cube, |s| s.levels(0, 0));
-        BakedEnvironment {
-            source,
-            specular: self.specular.unwrap_or_else(empty_cube),
-            irradiance: self.irradiance.unwrap_or_else(empty_cube),
-            lut: self.lut.unwrap_or_else(empty_table),
-            sheen: self.sheen.unwrap_or_else(empty_cube),
-            sheen_tables: self.sheen_tables.unwrap_or_else(empty_table),
-            mapping,
+    /// What a renderer reads: the products baked, the source cube's level 0 (the sharp sky)
+    /// in place of the source cube, and the roughness of the specular mips.
+    pub fn into_display(mut self, mapping: RoughnessMapping) -> BakedEnvironment {
+        if let Some(Item::Cube(source)) = self.take(Product::SourceCube) {
+            self.insert(Product::SourceCube, Item::Cube(source.levels(0, 0)));
         }
+        let mut env = BakedEnvironment { cubes: BTreeMap::new(), tables: BTreeMap::new(), mapping };
+        for (p, item) in self.items {
+            match item {
+                Item::Cube(c) => {
+                    env.cubes.insert(p, c);
+                }
+                Item::Table(t) => {
+                    env.tables.insert(p, t);
+                }
+                Item::Coefficients(_) => {}
+            }
+        }
+        env
     }
 }
 
-/// What a renderer reads, in host memory: the sharp sky, the specular cube, the irradiance
-/// cube, the BRDF table, and the sheen cube and tables.
+/// What a renderer reads, in host memory: the cubes (the sharp sky, the specular,
+/// irradiance and sheen cubes) and the tables (the BRDF table, the sheen tables) baked,
+/// and the roughness of the specular mips. A product not baked reads as a 1×1 stand-in of
+/// zeros (nothing reads it).
 #[derive(Clone)]
 pub struct BakedEnvironment {
-    /// The source cube's level 0 (the sharp sky).
-    pub source: Cube,
-    /// Prefiltered specular cube.
-    pub specular: Cube,
-    /// Irradiance cube (`E/π`).
-    pub irradiance: Cube,
-    /// BRDF table.
-    pub lut: Lut,
-    /// Sheen cube (a 1×1 stand-in where nothing reads it).
-    pub sheen: Cube,
-    /// Sheen tables (the Charlie table, the sheen albedo; a 1×1 stand-in where nothing
-    /// reads them).
-    pub sheen_tables: Lut,
+    /// The cubes baked (the source cube: its level 0 only).
+    pub cubes: BTreeMap<Product, Cube>,
+    /// The tables baked.
+    pub tables: BTreeMap<Product, Lut>,
     /// Roughness of the specular mips.
     pub mapping: RoughnessMapping,
 }
 
+static EMPTY_CUBE: std::sync::LazyLock<Cube> = std::sync::LazyLock::new(empty_cube);
+static EMPTY_TABLE: std::sync::LazyLock<Lut> = std::sync::LazyLock::new(empty_table);
+
 impl BakedEnvironment {
+    /// The cube `p`, or a 1×1 stand-in of zeros.
+    pub fn cube(&self, p: Product) -> &Cube {
+        self.cubes.get(&p).unwrap_or(&EMPTY_CUBE)
+    }
+
+    /// The table `p`, or a 1×1 stand-in of zeros.
+    pub fn table(&self, p: Product) -> &Lut {
+        self.tables.get(&p).unwrap_or(&EMPTY_TABLE)
+    }
+
     /// The display's exposure for this environment (`preview::auto_exposure`, the one
     /// rule: a white Lambert surface at 0.5 on average before the tone curve).
     pub fn auto_exposure(&self) -> f32 {
-        crate::preview::auto_exposure(&self.source)
+        crate::preview::auto_exposure(self.cube(Product::SourceCube))
     }
 
     /// The shapes the shaders need.
     pub fn shape(&self) -> EnvironmentShape {
+        let (source, specular, irradiance, sheen) =
+            (self.cube(Product::SourceCube), self.cube(Product::Specular), self.cube(Product::Irradiance), self.cube(Product::Sheen));
         EnvironmentShape {
-            specular_size: self.specular.layout.size,
-            specular_levels: self.specular.layout.levels,
+            specular_size: specular.layout.size,
+            specular_levels: specular.layout.levels,
             mapping: self.mapping as u32,
-            irradiance_size: self.irradiance.layout.size,
-            lut_size: self.lut.size,
-            source_size: self.source.layout.size,
+            irradiance_size: irradiance.layout.size,
+            lut_size: self.table(Product::BrdfTable).size,
+            source_size: source.layout.size,
             source_levels: 1,
-            irradiance_levels: self.irradiance.layout.levels,
-            sheen_size: self.sheen.layout.size,
-            sheen_levels: self.sheen.layout.levels,
-            sheen_mapping: crate::settings::SHEEN_MAPPING as u32,
-            sheen_table_size: self.sheen_tables.size,
+            irradiance_levels: irradiance.layout.levels,
+            sheen_size: sheen.layout.size,
+            sheen_levels: sheen.layout.levels,
+            sheen_mapping: Product::Sheen.mapping(self.mapping) as u32,
+            sheen_table_size: self.table(Product::SheenTables).size,
         }
     }
 }

@@ -11,6 +11,7 @@
 
 use crate::bake::BakedEnvironment;
 use crate::error::{Error, Result};
+use crate::product::{Product, Shape};
 use crate::texture::{Cube, Lut};
 use serde::{Deserialize, Serialize};
 use splitsum_shaders::cubemap::CubeLayout;
@@ -20,7 +21,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Version of the entry format (part of every key).
-pub const FORMAT: &str = "splitsum-cache-3";
+pub const FORMAT: &str = "splitsum-cache-4";
 
 /// The cache folder: `$SPLITSUM_CACHE`, else `$XDG_CACHE_HOME/splitsum`, else
 /// `~/.cache/splitsum`, else `.splitsum-cache`.
@@ -62,8 +63,11 @@ struct Manifest {
     files: BTreeMap<String, FileEntry>,
 }
 
-/// The files of an entry, as [`Cache::put`] writes them: the only names the cache removes.
-const ENTRY_FILES: [&str; 7] = ["manifest.json", "source.bin", "specular.bin", "irradiance.bin", "lut.bin", "sheen.bin", "sheen_tables.bin"];
+/// Whether `name` is a file [`Cache::put`] writes: the only names the cache removes
+/// (`manifest.json`, and `Product::cache_file` of each product).
+fn entry_file(name: &str) -> bool {
+    name == "manifest.json" || Product::ALL.iter().any(|p| p.cache_file() == name)
+}
 
 /// The largest entry manifest read (a real one is under a kilobyte).
 const MAX_MANIFEST_BYTES: u64 = 1 << 20;
@@ -93,7 +97,7 @@ fn remove_entry(dir: &Path) -> Result<()> {
             let e = e.map_err(|e| Error::file_caused(dir, "cannot read the cache entry", e))?;
             let name = e.file_name().to_string_lossy().into_owned();
             let is_file = e.file_type().is_ok_and(|t| t.is_file());
-            if !is_file || !ENTRY_FILES.contains(&name.as_str()) {
+            if !is_file || !entry_file(&name) {
                 return Err(foreign(&format!("holds {name}")));
             }
             names.push(name);
@@ -283,11 +287,24 @@ impl Cache {
             }
             Ok(bytes)
         };
-        let cube = |name: &'static str| cube_from(&file(name)?).ok_or(Rejection::NotACube(name));
-        let table = |name: &'static str| table_from(&file(name)?).ok_or(Rejection::NotATable(name));
-        let (source, specular, irradiance, lut) = (cube("source.bin")?, cube("specular.bin")?, cube("irradiance.bin")?, table("lut.bin")?);
-        let (sheen, sheen_tables) = (cube("sheen.bin")?, table("sheen_tables.bin")?);
-        Ok(BakedEnvironment { source, specular, irradiance, lut, sheen, sheen_tables, mapping: RoughnessMapping::from_u32(m.mapping) })
+        let mut env = BakedEnvironment { cubes: BTreeMap::new(), tables: BTreeMap::new(), mapping: RoughnessMapping::from_u32(m.mapping) };
+        // Every product the entry lists, and only those (a plan leaves some out).
+        for p in Product::ALL.into_iter().filter(|p| m.files.contains_key(p.cache_file())) {
+            let name = p.cache_file();
+            match p.shape() {
+                Shape::Cube => {
+                    env.cubes.insert(p, cube_from(&file(name)?).ok_or(Rejection::NotACube(name))?);
+                }
+                Shape::Table => {
+                    env.tables.insert(p, table_from(&file(name)?).ok_or(Rejection::NotATable(name))?);
+                }
+                Shape::Coefficients => return Err(Rejection::Unlisted(name)),
+            }
+        }
+        if !env.cubes.contains_key(&Product::SourceCube) {
+            return Err(Rejection::Unlisted(Product::SourceCube.cache_file()));
+        }
+        Ok(env)
     }
 
     /// Stores `env` under `key` (atomically: a temporary folder renamed into place).
@@ -306,15 +323,10 @@ impl Cache {
             .unwrap_or_else(|| Err(std::io::Error::other("no free temporary folder name")))
             .map_err(fail)?;
         let mut files = BTreeMap::new();
-        let source = env.source.levels(0, 0);
-        for (name, bytes) in [
-            ("source.bin", cube_bytes(&source)),
-            ("specular.bin", cube_bytes(&env.specular)),
-            ("irradiance.bin", cube_bytes(&env.irradiance)),
-            ("lut.bin", table_bytes(&env.lut)),
-            ("sheen.bin", cube_bytes(&env.sheen)),
-            ("sheen_tables.bin", table_bytes(&env.sheen_tables)),
-        ] {
+        // The source cube is its level 0 already (`Baked::into_display`).
+        let cubes = env.cubes.iter().map(|(p, c)| (p.cache_file(), cube_bytes(c)));
+        let tables = env.tables.iter().map(|(p, t)| (p.cache_file(), table_bytes(t)));
+        for (name, bytes) in cubes.chain(tables) {
             std::fs::write(tmp.join(name), &bytes).map_err(fail)?;
             files.insert(name.to_string(), FileEntry { bytes: bytes.len() as u64, blake3: blake3::hash(&bytes).to_hex().to_string() });
         }

@@ -3,8 +3,8 @@
 //! ([`measure_machine`]) and the bytes a bake holds, which `crate::estimate` turns into
 //! seconds and memory; the one search for a time budget ([`for_budget_by`]).
 
-use crate::measured::{Knob, Measurement, Method, Part, Product};
-use crate::settings::{InputShape, Job, Step, TableMethod};
+use crate::measured::{Knob, Measurement, Method, Part, Quantity};
+use crate::settings::{InputShape, Job, Product, TableMethod};
 use serde::Serialize;
 
 /// Error of each product against its reference, per setting: what the planner chooses
@@ -59,10 +59,10 @@ impl Calibration {
         let backend = &rows.iter().find(|r| !r.backend.is_empty())?.backend;
         for r in rows.iter().filter(|r| &r.backend == backend) {
             match (r.product, r.method, r.part) {
-                (Product::Irradiance, Method::Defaults, Part::Total) if r.knob == Knob::SourceSize => {
+                (Quantity::Irradiance, Method::Defaults, Part::Total) if r.knob == Knob::SourceSize => {
                     c.irradiance.push((r.source_size?, r.mean_error));
                 }
-                (Product::ShadedColour, Method::Defaults, Part::Bake) => {
+                (Quantity::ShadedColour, Method::Defaults, Part::Bake) => {
                     let (Some(lo), Some(hi), Some(n)) = (r.roughness_lo, r.roughness_hi, r.samples) else { continue };
                     let mid = 0.5 * (lo + hi);
                     match c.prefilter.iter_mut().find(|(x, _)| (*x - mid).abs() < 1e-3) {
@@ -130,23 +130,23 @@ impl Cost {
     }
 }
 
-/// A number per step of a bake (seconds, units of work), indexed by [`Step`].
+/// A number per step of a bake (seconds, units of work), indexed by [`Product`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct PerStep(pub [f64; 7]);
+pub struct PerStep(pub [f64; Product::COUNT]);
 
 /// Seconds of each step.
 pub type Seconds = PerStep;
 
-impl std::ops::Index<Step> for PerStep {
+impl std::ops::Index<Product> for PerStep {
     type Output = f64;
-    fn index(&self, s: Step) -> &f64 {
-        &self.0[Step::ALL.iter().position(|x| *x == s).expect("every step is listed")]
+    fn index(&self, s: Product) -> &f64 {
+        &self.0[s.index()]
     }
 }
 
-impl std::ops::IndexMut<Step> for PerStep {
-    fn index_mut(&mut self, s: Step) -> &mut f64 {
-        &mut self.0[Step::ALL.iter().position(|x| *x == s).expect("every step is listed")]
+impl std::ops::IndexMut<Product> for PerStep {
+    fn index_mut(&mut self, s: Product) -> &mut f64 {
+        &mut self.0[s.index()]
     }
 }
 
@@ -157,31 +157,14 @@ impl PerStep {
     }
 
     /// The step with the largest value.
-    pub fn longest(&self) -> Step {
-        Step::ALL.into_iter().max_by(|a, b| self[*a].total_cmp(&self[*b])).expect("seven steps")
+    pub fn longest(&self) -> Product {
+        Product::ALL.into_iter().max_by(|a, b| self[*a].total_cmp(&self[*b])).expect("a bake has steps")
     }
 }
 
-/// The bytes of `job`'s products in memory (each prefiltered level with its sums, the
-/// tables, the irradiance with its sums) and of its source cube.
+/// The bytes of `job`'s products in memory ([`bytes`]), its source cube included.
 pub fn product_bytes(job: &Job) -> u64 {
-    let mut bytes = job.source_layout().texel_count() as u64 * 16;
-    for cube in prefiltered_cubes(job) {
-        for &l in cube.levels {
-            // The sums (3 × RGBA per texel) and the result.
-            bytes += 6 * (job.specular_layout().level_size(l) as u64).pow(2) * 64;
-        }
-    }
-    if job.products.sheen {
-        bytes += (crate::table::SHEEN_TABLE_SIZE as u64).pow(2) * 24;
-    }
-    if job.products.lut {
-        bytes += (job.lut_size as u64).pow(2) * 24;
-    }
-    if job.products.irradiance {
-        bytes += 6 * (job.irradiance_size as u64).pow(2) * 64;
-    }
-    bytes
+    Product::ALL.iter().map(|p| bytes(*p, job)).sum()
 }
 
 /// The work of one step, by kind: what the cost model of `runner bench` counts.
@@ -216,104 +199,104 @@ impl std::ops::AddAssign for Work {
     }
 }
 
-/// The work of each step of `job`, in the order of [`Step::ALL`]. The BRDF table is a
-/// constant (`crate::table`): the defaults' is uploaded (its bytes only); another is
-/// integrated once per process, counted here as `lut::QUADRATURE_MEAN_EVALUATIONS` (or
-/// the samples) of about 60 operations per texel.
-pub fn step_work(job: &Job) -> [(Step, Work); 7] {
-    let mut out = Step::ALL.map(|s| (s, Work::default()));
-    fn at(out: &mut [(Step, Work); 7], s: Step) -> &mut Work {
-        &mut out.iter_mut().find(|(x, _)| *x == s).expect("every step").1
+/// The work of the step in `job`, by kind (see [`Work`] for what each kind counts).
+/// The BRDF table is a constant (`crate::table`): the defaults' is uploaded (its bytes
+/// only); another is integrated once per process, counted here as
+/// `lut::QUADRATURE_MEAN_EVALUATIONS` (or the samples) of about 60 operations per texel.
+pub fn work(p: Product, job: &Job) -> Work {
+    let mut w = Work::default();
+    if !job.products.has(p) {
+        return w;
     }
     let source = job.source_layout();
-    {
-        let w = at(&mut out, Step::SourceCube);
-        let level0 = 6.0 * (job.source_size as f64).powi(2);
-        if let InputShape::Equirect { width, height } = job.input {
-            let points = level0 * (job.supersample as f64).powi(2);
-            w.filtered_reads += 4.0 * points + (width as f64) * (height as f64);
-            w.flops += 80.0 * points;
+    let faces = |size: u32| 6.0 * (size as f64).powi(2);
+    match p {
+        Product::SourceCube => {
+            let level0 = faces(job.source_size);
+            if let InputShape::Equirect { width, height } = job.input {
+                let points = level0 * (job.supersample as f64).powi(2);
+                w.filtered_reads += 4.0 * points + (width as f64) * (height as f64);
+                w.flops += 80.0 * points;
+            }
+            let mips = (source.texel_count() as f64 - level0).max(0.0);
+            w.filtered_reads += 4.0 * mips;
+            w.flops += 20.0 * mips;
+            w.bytes += 16.0 * (w.filtered_reads + source.texel_count() as f64);
         }
-        let mips = (source.texel_count() as f64 - level0).max(0.0);
-        w.filtered_reads += 4.0 * mips;
-        w.flops += 20.0 * mips;
-        w.bytes += 16.0 * (w.filtered_reads + source.texel_count() as f64);
-    }
-    for cube in prefiltered_cubes(job) {
-        let w = at(&mut out, cube.step);
-        let layout = job.specular_layout();
-        for &l in cube.levels {
-            let texels = 6.0 * (layout.level_size(l) as f64).powi(2);
-            let m = l as usize;
-            if cube.lobe.is_mirror(cube.roughness[m]) {
-                w.filtered_reads += texels;
-            } else if cube.exact[m] != splitsum_shaders::prefilter::SAMPLED {
-                let terms = texels * 6.0 * (source.level_size(cube.exact[m]) as f64).powi(2);
-                w.summed_reads += terms;
-                w.flops += 90.0 * terms;
-            } else {
-                let samples = texels * job.samples_per_mip[m] as f64;
-                w.filtered_reads += 8.0 * samples;
-                w.flops += if cube.lobe == splitsum_shaders::prefilter::Lobe::Charlie { 330.0 } else { 140.0 } * samples;
+        p if p.lobe().is_some() => {
+            let cube = &job.prefiltered[&p];
+            let lobe = p.lobe().expect("a prefiltered cube has a lobe");
+            let layout = job.specular_layout();
+            for &l in &cube.levels {
+                let texels = faces(layout.level_size(l));
+                let m = l as usize;
+                if lobe.is_mirror(cube.roughness_per_mip[m]) {
+                    w.filtered_reads += texels;
+                } else if cube.exact_levels[m] != splitsum_shaders::prefilter::SAMPLED {
+                    let terms = texels * faces(source.level_size(cube.exact_levels[m]));
+                    w.summed_reads += terms;
+                    w.flops += 90.0 * terms;
+                } else {
+                    let samples = texels * job.samples_per_mip[m] as f64;
+                    w.filtered_reads += 8.0 * samples;
+                    w.flops += p.flops_per_sample() * samples;
+                }
+                w.bytes += 16.0 * texels;
+            }
+            w.bytes += 16.0 * (w.filtered_reads + w.summed_reads);
+        }
+        Product::Irradiance => {
+            // Each term reads the texel and its geometry (`cubemap::level_geometry`).
+            let terms = faces(job.irradiance_size) * faces(job.irradiance_source);
+            w.summed_reads += 2.0 * terms;
+            w.flops += 31.0 * terms;
+            w.bytes += 16.0 * (terms + faces(job.irradiance_size));
+        }
+        Product::Sh9 => {
+            let texels = faces(job.sh_source);
+            w.summed_reads += texels;
+            w.flops += 130.0 * texels;
+            w.bytes += 16.0 * texels;
+        }
+        Product::BrdfTable => {
+            let texels = (job.lut_size as f64).powi(2);
+            if crate::table::TableKey::of(job) != crate::table::TableKey::EMBEDDED {
+                let per_texel = match job.lut_method {
+                    TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
+                    TableMethod::Sampled => job.lut_samples,
+                };
+                w.flops += 60.0 * texels * per_texel as f64;
             }
             w.bytes += 16.0 * texels;
         }
-        w.bytes += 16.0 * (w.filtered_reads + w.summed_reads);
+        Product::SheenTables => w.bytes += 16.0 * (crate::table::SHEEN_TABLE_SIZE as f64).powi(2),
+        Product::Specular | Product::Sheen => unreachable!("a prefiltered cube"),
     }
-    if job.products.irradiance {
-        let w = at(&mut out, Step::Irradiance);
-        // Each term reads the texel and its geometry (`cubemap::level_geometry`).
-        let terms = 6.0 * (job.irradiance_size as f64).powi(2) * 6.0 * (job.irradiance_source as f64).powi(2);
-        w.summed_reads += 2.0 * terms;
-        w.flops += 31.0 * terms;
-        w.bytes += 16.0 * (terms + 6.0 * (job.irradiance_size as f64).powi(2));
-    }
-    if job.products.sh9 {
-        let w = at(&mut out, Step::Sh9);
-        let texels = 6.0 * (job.sh_source as f64).powi(2);
-        w.summed_reads += texels;
-        w.flops += 130.0 * texels;
-        w.bytes += 16.0 * texels;
-    }
-    if job.products.lut {
-        let w = at(&mut out, Step::BrdfTable);
-        let texels = (job.lut_size as f64).powi(2);
-        if crate::table::TableKey::of(job) != crate::table::TableKey::EMBEDDED {
-            let per_texel = match job.lut_method {
-                TableMethod::Quadrature => splitsum_shaders::lut::QUADRATURE_MEAN_EVALUATIONS,
-                TableMethod::Sampled => job.lut_samples,
-            };
-            w.flops += 60.0 * texels * per_texel as f64;
-        }
-        w.bytes += 16.0 * texels;
-    }
-    if job.products.sheen {
-        let w = at(&mut out, Step::SheenTables);
-        w.bytes += 16.0 * (crate::table::SHEEN_TABLE_SIZE as f64).powi(2);
-    }
-    out
+    w
 }
 
-/// One prefiltered cube of a job, as the cost model walks it.
-struct PrefilteredCube<'a> {
-    step: Step,
-    lobe: splitsum_shaders::prefilter::Lobe,
-    levels: &'a [u32],
-    roughness: &'a [f32],
-    exact: &'a [u32],
+/// The bytes the product holds in memory while `job` bakes it: a prefiltered level
+/// with its sums (3 × RGBA per texel) and the result, a table's texels and sums, the
+/// irradiance with its sums, the source cube.
+pub fn bytes(p: Product, job: &Job) -> u64 {
+    if !job.products.has(p) {
+        return 0;
+    }
+    let faces = |size: u32| 6 * (size as u64).pow(2);
+    match p {
+        Product::SourceCube => job.source_layout().texel_count() as u64 * 16,
+        p if p.lobe().is_some() => job.prefiltered[&p].levels.iter().map(|&l| faces(job.specular_layout().level_size(l)) * 64).sum(),
+        Product::Irradiance => faces(job.irradiance_size) * 64,
+        Product::Sh9 => 0,
+        Product::BrdfTable => (job.lut_size as u64).pow(2) * 24,
+        Product::SheenTables => (crate::table::SHEEN_TABLE_SIZE as u64).pow(2) * 24,
+        Product::Specular | Product::Sheen => unreachable!("a prefiltered cube"),
+    }
 }
 
-/// The prefiltered cubes `job` bakes: the specular cube, the sheen cube.
-fn prefiltered_cubes(job: &Job) -> Vec<PrefilteredCube<'_>> {
-    use splitsum_shaders::prefilter::Lobe;
-    let mut out = Vec::new();
-    if job.products.specular {
-        out.push(PrefilteredCube { step: Step::Specular, lobe: Lobe::Ggx, levels: &job.levels, roughness: &job.roughness_per_mip, exact: &job.exact_levels });
-    }
-    if job.products.sheen {
-        out.push(PrefilteredCube { step: Step::Sheen, lobe: Lobe::Charlie, levels: &job.sheen_levels, roughness: &job.sheen_roughness_per_mip, exact: &job.sheen_exact_levels });
-    }
-    out
+/// The work of each step of `job` ([`work`]), in the order of [`Product::ALL`].
+pub fn step_work(job: &Job) -> [(Product, Work); Product::COUNT] {
+    Product::ALL.map(|p| (p, work(p, job)))
 }
 
 /// What a device does per second on each kind of [`Work`], measured by the calibration
@@ -482,7 +465,7 @@ pub fn for_budget_by(
             let Ok(job) = settings.resolve(shape, products) else { continue };
             let seconds = seconds(&job);
             let specular_error = bands.iter().map(|r| cal.prefilter_error(*r, n)).sum::<f64>() / bands.len().max(1) as f64;
-            let error = if products.specular { specular_error } else { 0.0 } + if products.irradiance { irradiance_error } else { 0.0 };
+            let error = if products.has(Product::Specular) { specular_error } else { 0.0 } + if products.has(Product::Irradiance) { irradiance_error } else { 0.0 };
             let candidate = (settings, error, seconds);
             if seconds <= budget && best.as_ref().is_none_or(|b| error < b.1 || (error == b.1 && seconds < b.2)) {
                 best = Some(candidate.clone());

@@ -73,7 +73,7 @@ pub enum Error {
         /// The estimate, in seconds.
         seconds: f64,
         /// Its longest step.
-        step: crate::field::Step,
+        step: crate::product::Product,
         /// That step's estimate.
         step_seconds: f64,
     },

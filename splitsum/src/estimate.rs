@@ -16,7 +16,7 @@
 //!
 //! where the limit is at the rates the device reaches unloaded, divided by the share of the
 //! processors this process gets now where the work runs on them ([`availability`]), the
-//! shares measured by `runner bench` here ([`SHARES_CPU`], [`SHARES_GPU`]), and `c`
+//! shares measured by `runner bench` here (`Product::share`), and `c`
 //! the geometric mean of measured/estimated over the steps already done in this process,
 //! shrunk towards 1 as if one more step had been exactly right: a load that changes after
 //! the calibration moves the later estimates with it. How sure: before any step has been
@@ -25,26 +25,13 @@
 //! were off.
 
 use crate::cost::{Machine, step_work};
-use crate::settings::{Job, Step};
+use crate::settings::{Job, Product};
 
 // What progress shows of an estimate, and from how long a step on: progress's own (it
 // depends on nothing here; the cost model this module reads depends on the backends,
 // which speak through progress).
 pub use crate::progress::Estimate;
 use crate::progress::SHOWN;
-
-/// The share of its limit each step reaches, in the order of [`Step::ALL`], on 2 CPU cores:
-/// the median of limit/time over five quiet `runner bench --runs 1` of city.exr, with and
-/// without `--sheen` (the tuning set; each a process of its own, calibrated as a bake is,
-/// December 2026), confirmed on four held-out configurations (courtyard.exr, studio.exr at
-/// 512², sunset.exr at 128², forest.exr for the khronos target). The irradiance and SH9
-/// steps take under 50 ms here (no estimate is shown or learnt from): the summed reads'
-/// share of lavapipe, rounded. The tables are uploaded constants: no work the limits
-/// measure, no share.
-pub const SHARES_CPU: [f64; 7] = [0.52, 1.01, 0.6, 0.6, 1.0, 1.25, 1.0];
-
-/// The same on a GPU: measured on lavapipe, likewise (no hardware GPU has been measured).
-pub const SHARES_GPU: [f64; 7] = [0.41, 0.76, 0.67, 0.67, 1.0, 0.70, 1.0];
 
 /// How far a step's estimate may be off before any step of this process has been timed,
 /// on a quiet machine: the 90th percentile of |estimate/measured − 1| over the steps shown
@@ -81,7 +68,7 @@ pub struct Estimator {
     /// The share of its processors this process gets (1 on a quiet machine, and for a
     /// hardware GPU, whose work is not the processors').
     availability: f64,
-    shares: [f64; 7],
+    gpu: bool,
     /// Σ ln(measured/estimated) over the steps timed, and their count.
     log_ratio: f64,
     timed: f64,
@@ -94,7 +81,7 @@ pub struct Estimator {
 impl Estimator {
     /// An estimator from `machine`'s measured rates, for a GPU (`gpu`) or the CPU.
     pub fn new(machine: Machine, gpu: bool, rates: Rates) -> Self {
-        Self { machine, availability: 1.0, shares: if gpu { SHARES_GPU } else { SHARES_CPU }, log_ratio: 0.0, timed: 0.0, worst: 0.0, rates }
+        Self { machine, availability: 1.0, gpu, log_ratio: 0.0, timed: 0.0, worst: 0.0, rates }
     }
 
     /// The estimator with the share of its processors this process gets (see
@@ -115,22 +102,22 @@ impl Estimator {
         (self.log_ratio / (self.timed + 1.0)).exp()
     }
 
-    /// The estimate of each step of `job`, in the order of [`Step::ALL`].
-    pub fn steps(&self, job: &Job) -> [(Step, Estimate); 7] {
+    /// The estimate of each step of `job`, in the order of [`Product::ALL`].
+    pub fn steps(&self, job: &Job) -> [(Product, Estimate); Product::COUNT] {
         let c = self.correction();
         let base = if self.availability < LOADED { LOADED_SPREAD } else { MODEL_SPREAD };
         let within = if self.rates == Rates::BuiltIn { f64::INFINITY } else { base.max(self.worst) };
         let work = step_work(job);
-        let mut out = Step::ALL.map(|s| (s, Estimate { seconds: 0.0, within }));
+        let mut out = Product::ALL.map(|s| (s, Estimate { seconds: 0.0, within }));
         for (k, (step, w)) in work.iter().enumerate() {
             let (limit, _) = self.machine.limit(w);
-            out[k] = (*step, Estimate { seconds: limit / self.shares[k] / self.availability * c, within });
+            out[k] = (*step, Estimate { seconds: limit / step.share(self.gpu) / self.availability * c, within });
         }
         out
     }
 
     /// The estimate of step `step` of `job`.
-    pub fn step(&self, job: &Job, step: Step) -> Estimate {
+    pub fn step(&self, job: &Job, step: Product) -> Estimate {
         self.steps(job).into_iter().find(|(s, _)| *s == step).expect("every step").1
     }
 
@@ -320,14 +307,14 @@ mod tests {
         let machine = Machine { filtered_reads: 1e9, summed_reads: 1e9, flops: 1e10 };
         let job = crate::Settings::default().resolve(crate::environment::InputShape::Equirect { width: 1024, height: 512 }, crate::Products::STANDARD).unwrap();
         let mut e = Estimator::new(machine, false, Rates::Measured { seconds: 0.0 });
-        let before = e.step(&job, Step::Specular);
+        let before = e.step(&job, Product::Specular);
         assert_eq!(before.within, MODEL_SPREAD);
         e.record(0.04, 1.0);
-        assert_eq!(e.step(&job, Step::Specular), before, "a step under 50 ms teaches nothing");
+        assert_eq!(e.step(&job, Product::Specular), before, "a step under 50 ms teaches nothing");
         e.record(1.0, 4.0);
-        let after = e.step(&job, Step::Specular);
+        let after = e.step(&job, Product::Specular);
         assert!((after.seconds / before.seconds - 2.0).abs() < 1e-12, "{} / {}", after.seconds, before.seconds);
         assert!((after.within - 3.0).abs() < 1e-12);
-        assert!(Estimator::built_in(true).step(&job, Step::Specular).within.is_infinite(), "built-in rates claim no bound");
+        assert!(Estimator::built_in(true).step(&job, Product::Specular).within.is_infinite(), "built-in rates claim no bound");
     }
 }

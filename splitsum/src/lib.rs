@@ -95,13 +95,15 @@ internal_modules! {
     ktx2;
     measured;
     preview;
+    product;
     settings;
     table;
     textures;
 }
 
 pub use error::{Error, Result};
-pub use settings::{Field, Job, Products, Settings, TableMethod, Target};
+pub use product::{Product, Products};
+pub use settings::{Field, Job, Settings, TableMethod, Target};
 pub use splitsum_shaders::brdf::microfacet::Masking;
 pub use splitsum_shaders::equirect::Facing;
 pub use splitsum_shaders::prefilter::RoughnessMapping;
@@ -114,7 +116,6 @@ pub mod low_level {
     pub use crate::adjustment::Adjustment;
     pub use crate::backend::{Backend, BackendKind, Gpu};
     pub use crate::bake::{Baked, Batched, Made, Timing, bake, bake_batch};
-    pub use crate::field::Step;
 }
 
 // The workbench of the command line, its display and its report (`internals`): the names
@@ -124,9 +125,9 @@ pub use crate::{
     backend::{Backend, BackendKind, Gpu},
     bake::{Baked, Batched, Timing, bake, bake_batch, bake_job},
     environment::{Environment, InputReport, InputShape},
-    field::Step,
     ktx2::Written,
     output::{About, Manifest},
+    product::Item,
     texture::Format,
 };
 #[cfg(feature = "internals")]

@@ -8,7 +8,7 @@ use serde::{Deserialize, Serialize};
 /// What is measured.
 #[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Product {
+pub enum Quantity {
     /// The BRDF table at its texel centres.
     BrdfTable,
     /// The BRDF table read bilinearly between texel centres.
@@ -26,17 +26,17 @@ pub enum Product {
     ShadingCost,
 }
 
-impl Product {
+impl Quantity {
     /// Its name in the report.
     pub fn title(self) -> &'static str {
         match self {
-            Product::BrdfTable => "BRDF table",
-            Product::BrdfTableLookup => "BRDF table, bilinear lookup",
-            Product::Prefilter => "prefiltered cube",
-            Product::Irradiance => "irradiance",
-            Product::ShadedColour => "shaded colour",
-            Product::PrefilteredLookup => "prefiltered lookup, any roughness",
-            Product::ShadingCost => "shading cost per pixel",
+            Quantity::BrdfTable => "BRDF table",
+            Quantity::BrdfTableLookup => "BRDF table, bilinear lookup",
+            Quantity::Prefilter => "prefiltered cube",
+            Quantity::Irradiance => "irradiance",
+            Quantity::ShadedColour => "shaded colour",
+            Quantity::PrefilteredLookup => "prefiltered lookup, any roughness",
+            Quantity::ShadingCost => "shading cost per pixel",
         }
     }
 }
@@ -180,7 +180,7 @@ pub enum Metric {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Measurement {
     /// What is measured.
-    pub product: Product,
+    pub product: Quantity,
     /// How it was made.
     pub method: Method,
     /// Which part of the error.
@@ -238,7 +238,7 @@ pub struct Measurement {
 impl Measurement {
     /// A row of `product` by `method` from its `errors` (their mean and largest), every
     /// knob column empty: set them with struct update syntax.
-    pub fn of(product: Product, method: Method, errors: &[f64], metric: Metric) -> Self {
+    pub fn of(product: Quantity, method: Method, errors: &[f64], metric: Metric) -> Self {
         let mean_error = errors.iter().sum::<f64>() / errors.len().max(1) as f64;
         let max_error = errors.iter().copied().fold(0.0, f64::max);
         Self {

@@ -12,7 +12,7 @@ use crate::ktx1;
 use crate::ktx2;
 use crate::ktx2::Supercompression;
 use crate::preview;
-use crate::settings::{Job, Target};
+use crate::settings::{Job, Product, Target};
 use crate::texture::{Cube, Sh9};
 use serde::Serialize;
 use splitsum_shaders::choice::Choice;
@@ -170,7 +170,7 @@ internal! {
             environment: about.environment,
             backend: about.backend,
             settings: job.clone(),
-            roughness_per_mip: job.roughness_per_mip.clone(),
+            roughness_per_mip: job.roughness_per_mip().to_vec(),
             samples_per_mip: job.samples_per_mip.clone(),
             accuracy: DEFAULTS_ACCURACY,
             input: about.input.as_ref().map(InputSummary::from),
@@ -188,40 +188,69 @@ internal! {
         }
         // Each file is a job of its own, run on every core at once; the manifest lists them
         // in this order.
-        type Job<'a> = Box<dyn FnOnce() -> Result<Vec<OutputFile>> + Send + 'a>;
-        let mut jobs: Vec<Job<'_>> = Vec::new();
-        let file = |name: &str, what: String, written: Option<ktx2::Written>| OutputFile { name: name.to_string(), what, written };
-        // Previews at the source's exposure (the specular cube's mip 0 where no source was kept).
-        let sky = baked.source.as_ref().or(baked.specular.as_ref());
+        let sky = baked.cube(Product::SourceCube).or(baked.cube(Product::Specular));
         let exposure = sky.map_or(1.0, preview::auto_exposure);
-        let save_png = move |name: &str, pic: &preview::Picture| -> Result<()> {
-            files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
+        let jobs: Vec<FileJob<'_>> = baked.products().flat_map(|p| splitsum_files(p, dir, baked, job, exposure)).collect();
+        let files_out: Vec<OutputFile> = {
+            use rayon::prelude::*;
+            jobs.into_par_iter().map(|j| j()).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect()
         };
-        if let Some(source) = &baked.source {
+        manifest.files = files_out;
+        if let (Some(sh), Some(irr)) = (baked.sh9(), baked.cube(Product::Irradiance)) {
+            manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
+        }
+        write_manifest(dir, manifest)
+    }
+}
+
+/// One file (or a few) of the splitsum folder, written on a core of its own.
+type FileJob<'a> = Box<dyn FnOnce() -> Result<Vec<OutputFile>> + Send + 'a>;
+
+/// The files of product `p` in splitsum's folder `dir`: a prefiltered cube (any lobe) as
+/// `KEY.ktx2` with a preview of its mips (and the specular cube's mips as EXR), the
+/// irradiance as KTX2, EXR and a preview, SH9 as JSON, each table as EXR (with a preview
+/// of the BRDF table), the source cube as a preview; previews at `exposure`.
+fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job, exposure: f32) -> Vec<FileJob<'a>> {
+    let file = |name: &str, what: String, written: Option<ktx2::Written>| OutputFile { name: name.to_string(), what, written };
+    let save_png = move |name: &str, pic: &preview::Picture| -> Result<()> {
+        files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
+    };
+    let mut jobs: Vec<FileJob<'a>> = Vec::new();
+    if let (Some(cube), Some(_)) = (baked.cube(p), p.lobe()) {
+        let key = p.key();
+        let mapping = job.prefiltered[&p].mapping;
+        jobs.push(Box::new(move || {
+            let name = format!("{key}.ktx2");
+            let w = ktx2::write(&dir.join(&name), cube, job.format)?;
+            report_clamp(&name, &w);
+            Ok(vec![file(&name, format!("{}, one roughness per mip ({} mapping: settings.prefiltered.{key}.roughness_per_mip)", p.about(), mapping.name()), Some(w))])
+        }));
+        if p == Product::Specular {
+            for m in 0..cube.layout.levels {
+                jobs.push(Box::new(move || {
+                    let name = format!("specular_mip{m}.exr");
+                    files::write_cube_level_exr(&dir.join(&name), cube, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip()[m as usize]))?;
+                    Ok(vec![file(&name, format!("mip {m} as EXR for inspection"), None)])
+                }));
+            }
+        }
+        jobs.push(Box::new(move || {
+            let name = format!("preview_{key}.png");
+            save_png(&name, &preview::mip_strip(cube, 64))?;
+            Ok(vec![file(&name, format!("every {p} mip as a cross, roughness rising to the right"), None)])
+        }));
+        return jobs;
+    }
+    match p {
+        Product::SourceCube => {
+            let Some(source) = baked.cube(p) else { return jobs };
             jobs.push(Box::new(move || {
                 save_png("preview_source.png", &preview::cross(source, 0, job.source_size.min(256)))?;
                 Ok(vec![file("preview_source.png", "the source cube, tonemapped (ACES, auto exposure), as a cross".into(), None)])
             }));
         }
-        if let Some(spec) = &baked.specular {
-            jobs.push(Box::new(move || {
-                let w = ktx2::write(&dir.join("specular.ktx2"), spec, job.format)?;
-                report_clamp("specular.ktx2", &w);
-                Ok(vec![file("specular.ktx2", "GGX-prefiltered radiance, one roughness per mip (roughness_per_mip)".into(), Some(w))])
-            }));
-            for m in 0..spec.layout.levels {
-                jobs.push(Box::new(move || {
-                    let name = format!("specular_mip{m}.exr");
-                    files::write_cube_level_exr(&dir.join(&name), spec, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip[m as usize]))?;
-                    Ok(vec![file(&name, format!("mip {m} as EXR for inspection"), None)])
-                }));
-            }
-            jobs.push(Box::new(move || {
-                save_png("preview_specular.png", &preview::mip_strip(spec, 64))?;
-                Ok(vec![file("preview_specular.png", "every specular mip as a cross, roughness rising to the right".into(), None)])
-            }));
-        }
-        if let Some(irr) = &baked.irradiance {
+        Product::Irradiance => {
+            let Some(irr) = baked.cube(p) else { return jobs };
             jobs.push(Box::new(move || {
                 let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, job.format)?;
                 report_clamp("irradiance.ktx2", &w);
@@ -234,7 +263,8 @@ internal! {
                 ])
             }));
         }
-        if let Some(sh) = &baked.sh9 {
+        Product::Sh9 => {
+            let Some(sh) = baked.sh9() else { return jobs };
             jobs.push(Box::new(move || {
                 let file_contents = ShFile {
                     convention: "real SH (Sloan 2008), radiance L_lm = sum L Y_lm dOmega; E(n)/pi = sum (A_l/pi) L_lm Y_lm(n), A_l/pi = 1, 2/3, 1/4",
@@ -247,7 +277,8 @@ internal! {
                 Ok(vec![file("sh9.json", format!("{SH9} spherical-harmonic coefficients of radiance and of E/π"), None)])
             }));
         }
-        if let Some(lut) = &baked.lut {
+        Product::BrdfTable => {
+            let Some(lut) = baked.table(p) else { return jobs };
             jobs.push(Box::new(move || {
                 files::write_lut_exr(&dir.join("brdf_lut.exr"), lut)?;
                 files::write_png(&dir.join("brdf_lut.png"), lut.size, lut.size, &files::lut_preview(lut))?;
@@ -257,33 +288,20 @@ internal! {
                 ])
             }));
         }
-        if let (Some(sheen), Some(tables)) = (&baked.sheen, &baked.sheen_tables) {
+        Product::SheenTables => {
+            let Some(tables) = baked.table(p) else { return jobs };
             jobs.push(Box::new(move || {
-                let w = ktx2::write(&dir.join("sheen.ktx2"), sheen, job.format)?;
-                report_clamp("sheen.ktx2", &w);
                 files::write_lut_exr(&dir.join("sheen_tables.exr"), tables)?;
-                save_png("preview_sheen.png", &preview::mip_strip(sheen, 64))?;
-                Ok(vec![
-                    file("sheen.ktx2", "Charlie-prefiltered radiance (sheen), mip m at sheen roughness m/(mips-1) (sheen_roughness_per_mip)".into(), Some(w)),
-                    file(
-                        "sheen_tables.exr",
-                        "sheen tables: R = Charlie table (Neubelt visibility; the glTF Sample Viewer's lut_charlie), G = sheen albedo (Charlie visibility; lut_sheen_E); x = n·v, y = sheen roughness".into(),
-                        None,
-                    ),
-                    file("preview_sheen.png", "every sheen mip as a cross, sheen roughness rising to the right".into(), None),
-                ])
+                Ok(vec![file(
+                    "sheen_tables.exr",
+                    "sheen tables: R = Charlie table (Neubelt visibility; the glTF Sample Viewer's lut_charlie), G = sheen albedo (Charlie visibility; lut_sheen_E); x = n·v, y = sheen roughness".into(),
+                    None,
+                )])
             }));
         }
-        let files_out: Vec<OutputFile> = {
-            use rayon::prelude::*;
-            jobs.into_par_iter().map(|j| j()).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect()
-        };
-        manifest.files = files_out;
-        if let (Some(sh), Some(irr)) = (&baked.sh9, &baked.irradiance) {
-            manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
-        }
-        write_manifest(dir, manifest)
+        Product::Specular | Product::Sheen => {}
     }
+    jobs
 }
 
 fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
@@ -326,24 +344,24 @@ pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> 
                 files::create_folder(&dir.join("ggx"))?;
                 files::create_folder(&dir.join("lambertian"))?;
             }
-            let spec = baked.specular.as_ref().ok_or_else(|| missing("specular cube"))?;
+            let spec = baked.cube(Product::Specular).ok_or_else(|| missing("specular cube"))?;
             let w = ktx2::write_with(&dir.join(spec_name), spec, job.format, sc)?;
             report_clamp(spec_name, &w);
             add(spec_name.into(), "GGX-prefiltered radiance, mip m at perceptual roughness m/(mips-1)", Some(w));
-            let irr = baked.irradiance.as_ref().ok_or_else(|| missing("irradiance cube"))?;
+            let irr = baked.cube(Product::Irradiance).ok_or_else(|| missing("irradiance cube"))?;
             let w = ktx2::write_with(&dir.join(diffuse_name), irr, job.format, sc)?;
             report_clamp(diffuse_name, &w);
             add(diffuse_name.into(), "irradiance divided by pi (Lambertian-filtered radiance)", Some(w));
-            let lut = baked.lut.as_ref().ok_or_else(|| missing("BRDF table"))?;
+            let lut = baked.table(Product::BrdfTable).ok_or_else(|| missing("BRDF table"))?;
             if khronos {
                 files::write_png(&dir.join("lut_ggx.png"), lut.size, lut.size, &files::lut_preview(lut))?;
                 add("lut_ggx.png".into(), "split-sum table, height-correlated Smith: R = A, G = B (8-bit), x = n.v, y = roughness", None);
-                if let Some(sheen) = &baked.sheen {
+                if let Some(sheen) = baked.cube(Product::Sheen) {
                     files::create_folder(&dir.join("charlie"))?;
                     let w = ktx2::write_with(&dir.join("charlie/sheen.ktx2"), sheen, job.format, sc)?;
                     report_clamp("charlie/sheen.ktx2", &w);
                     add("charlie/sheen.ktx2".into(), "Charlie-prefiltered radiance (sheen), mip m at sheen roughness m/(mips-1)", Some(w));
-                    let t = baked.sheen_tables.as_ref().ok_or_else(|| missing("sheen tables"))?;
+                    let t = baked.table(Product::SheenTables).ok_or_else(|| missing("sheen tables"))?;
                     files::write_png(&dir.join("lut_charlie.png"), t.size, t.size, &files::table_channel_png(t, |v| v.x))?;
                     add(
                         "lut_charlie.png".into(),
@@ -367,13 +385,13 @@ pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> 
             }
         }
         Target::Filament => {
-            let sh = baked.sh9.as_ref().ok_or_else(|| missing("SH9 coefficients"))?;
+            let sh = baked.sh9().ok_or_else(|| missing("SH9 coefficients"))?;
             let c = sh9_polynomial(&sh.as_vec4());
             let metadata: String = c.iter().map(|v| format!("{} {} {}\n", v.x, v.y, v.z)).collect();
             const NAMES: [&str; SH9] = ["L00", "L1-1", "L10", "L11", "L2-2", "L2-1", "L20", "L21", "L22"];
             let text: String =
                 c.iter().zip(NAMES).map(|(v, n)| format!("({:18.15}, {:18.15}, {:18.15}); // {n}, irradiance, pre-scaled base\n", v.x, v.y, v.z)).collect();
-            let spec = baked.specular.as_ref().ok_or_else(|| missing("specular cube"))?;
+            let spec = baked.cube(Product::Specular).ok_or_else(|| missing("specular cube"))?;
             let ibl = format!("{name}_ibl.ktx");
             let w = ktx1::write(&dir.join(&ibl), spec, &[("sh", &metadata)])?;
             report_clamp(&ibl, &w);
@@ -382,7 +400,7 @@ pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> 
                 "GGX-prefiltered radiance (KTX 1.1, R11F_G11F_B10F), mip m at perceptual roughness 1 - sqrt(1 - m/(mips-1)); 'sh' metadata: E/pi SH for the shader",
                 Some(w),
             );
-            let sky = baked.source.as_ref().ok_or_else(|| missing("source cube (the skybox)"))?.levels(0, 0);
+            let sky = baked.cube(Product::SourceCube).ok_or_else(|| missing("source cube (the skybox)"))?.levels(0, 0);
             let skybox = format!("{name}_skybox.ktx");
             let w = ktx1::write(&dir.join(&skybox), &sky, &[])?;
             report_clamp(&skybox, &w);
@@ -439,7 +457,7 @@ pub(crate) const DEFAULTS_ACCURACY: &str = "defaults (256² cube, 6 mips, geomet
 pub(crate) const CONVENTIONS: [&str; 5] = [
     "cube faces +X -X +Y -Y +Z -Z, Vulkan/KTX2 orientation (OpenGL 4.6 table 8.19)",
     "equirect: image centre looks down -Z, +Y up; u = 0.5 + atan2(x, -z)/2pi, v = polar angle/pi",
-    "specular mip m holds roughness roughness_per_mip[m] (alpha = roughness^2), GGX with n = v = r; sheen mip m holds sheen roughness sheen_roughness_per_mip[m], Charlie with n = v",
+    "specular mip m holds roughness roughness_per_mip[m] (alpha = roughness^2), GGX with n = v = r; sheen mip m holds sheen roughness prefiltered.sheen.roughness_per_mip[m], Charlie with n = v",
     "irradiance values are E/pi: a Lambert surface of albedo rho reflects rho times the value",
     "half-float overflow: values above 65504 are clamped and counted (format rgba16f) or kept in rgba32f (format auto)",
 ];

@@ -93,9 +93,7 @@ pub fn texels(key: TableKey) -> Result<Arc<Vec<Vec4>>> {
     Ok(t)
 }
 
-/// Texels per side of the sheen tables. Both are smooth in n·v and in roughness (no kink
-/// inside a texel); the glTF Sample Viewer samples them bilinearly.
-pub const SHEEN_TABLE_SIZE: u32 = 64;
+pub use crate::product::SHEEN_TABLE_SIZE;
 
 /// The sheen tables as `(Charlie table, sheen albedo)` little-endian f32 pairs per texel,
 /// written by `bash scripts/dev.sh table` (a fresh CPU computation takes 3 s on 2 cores).

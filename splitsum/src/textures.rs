@@ -18,7 +18,9 @@ use crate::bake::{self, Baked, Made, Timing};
 use crate::estimate::Estimator;
 use crate::environment::Environment;
 use crate::error::{Error, Result};
-use crate::settings::{InputShape, Job, Products, Settings, Step};
+use crate::product::{Item, Layout};
+use crate::settings::{InputShape, Job, Product, Products, Settings};
+use std::collections::BTreeMap;
 use crate::texture::{Cube, Equirect, Lut};
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
@@ -172,7 +174,7 @@ impl Baker {
                         let start = web_time::Instant::now();
                         let (src, layout) = texture_source_cube(g, t, &job)?;
                         g.finish()?;
-                        timings.push(Timing { step: Step::SourceCube, seconds: start.elapsed().as_secs_f64(), estimate: None });
+                        timings.push(Timing { step: Product::SourceCube, seconds: start.elapsed().as_secs_f64(), estimate: None });
                         bake::products(g, src, layout, &job, &mut est, timings)?
                     }
                 };
@@ -189,7 +191,7 @@ impl Baker {
                 };
                 let made = bake::make(&Cpu, &mut Estimator::built_in(false), env, &job)?;
                 let baked = bake::read(&Cpu, made, &job)?;
-                Ok(self.upload(&baked, &job))
+                self.upload(&baked, &job)
             }
         }
     }
@@ -209,52 +211,44 @@ impl Baker {
         })
     }
 
-    /// The textures of `job`'s products, empty.
-    fn textures(&self, job: &Job) -> (wgpu::Texture, wgpu::Texture, wgpu::Texture) {
-        let half4 = wgpu::TextureFormat::Rgba16Float;
-        (
-            self.texture("splitsum specular", job.size, FACES, job.mips, half4),
-            self.texture("splitsum irradiance", job.irradiance_size, FACES, 1, half4),
-            self.texture("splitsum brdf table", job.lut_size, 1, 1, wgpu::TextureFormat::Rg16Float),
-        )
-    }
-
-    /// The sheen cube and tables of `job`, empty, where it bakes them.
-    fn sheen_textures(&self, job: &Job) -> Option<SheenTextures> {
-        if !job.products.sheen {
-            return None;
+    /// The texture of each product of `job` a renderer reads (every cube and table but
+    /// the source cube), empty: a cube of `Rgba16Float` in the product's layout, a table of
+    /// `Rg16Float`.
+    fn textures(&self, job: &Job) -> BTreeMap<Product, (wgpu::Texture, CubeLayout, u32, u32)> {
+        let mut out = BTreeMap::new();
+        for p in job.products.iter().filter(|p| *p != Product::SourceCube) {
+            let label = format!("splitsum {p}");
+            // (layout, layers, channels)
+            let (layout, layers, channels, format) = match job.layout(p) {
+                Layout::Cube(l) => (l, FACES, 4, wgpu::TextureFormat::Rgba16Float),
+                Layout::Table(size) => (CubeLayout::new(size, 1), 1, 2, wgpu::TextureFormat::Rg16Float),
+                Layout::Coefficients => continue,
+            };
+            out.insert(p, (self.texture(&label, layout.size, layers, layout.levels, format), layout, layers, channels));
         }
-        let t = crate::table::SHEEN_TABLE_SIZE;
-        Some(SheenTextures {
-            cube: self.texture("splitsum sheen", job.size, FACES, job.mips, wgpu::TextureFormat::Rgba16Float),
-            tables: self.texture("splitsum sheen tables", t, 1, 1, wgpu::TextureFormat::Rg16Float),
-            roughness: job.sheen_roughness_per_mip.clone(),
-        })
+        out
     }
 
-    fn ibl(&self, job: &Job, textures: (wgpu::Texture, wgpu::Texture, wgpu::Texture), sheen: Option<SheenTextures>, timings: Vec<Timing>) -> Ibl {
-        let (specular, irradiance, brdf) = textures;
-        Ibl { specular, irradiance, brdf, roughness: job.roughness_per_mip.clone(), mapping: job.mapping, sheen, timings, job: job.clone() }
+    /// The [`Ibl`] of `job` from the texture of each product.
+    fn ibl(&self, job: &Job, mut textures: BTreeMap<Product, (wgpu::Texture, CubeLayout, u32, u32)>, timings: Vec<Timing>) -> Result<Ibl> {
+        let mut take = |p: Product| textures.remove(&p).map(|t| t.0).ok_or_else(|| Error::Invalid(format!("a display bake made no {p}")));
+        let (specular, irradiance, brdf) = (take(Product::Specular)?, take(Product::Irradiance)?, take(Product::BrdfTable)?);
+        let sheen = if job.products.has(Product::Sheen) {
+            Some(SheenTextures { cube: take(Product::Sheen)?, tables: take(Product::SheenTables)?, roughness: job.prefiltered[&Product::Sheen].roughness_per_mip.clone() })
+        } else {
+            None
+        };
+        Ok(Ibl { specular, irradiance, brdf, roughness: job.roughness_per_mip().to_vec(), mapping: job.mapping, sheen, timings, job: job.clone() })
     }
 
     /// Packs the products on the device and copies them into the textures.
     fn gpu_textures(&self, g: &Gpu, made: Made<Texels>, job: &Job) -> Result<Ibl> {
         let textures = self.textures(job);
-        let missing = || Error::Invalid("a display bake made no product".into());
-        let spec = made.specular.as_ref().ok_or_else(missing)?;
-        let irr = made.irradiance.as_ref().ok_or_else(missing)?;
-        let lut = made.lut.as_ref().ok_or_else(missing)?;
-        self.gpu_copy(g, spec, job.specular_layout(), FACES, 4, &textures.0)?;
-        self.gpu_copy(g, irr, job.irradiance_layout(), FACES, 4, &textures.1)?;
-        self.gpu_copy(g, lut, CubeLayout::new(job.lut_size, 1), 1, 2, &textures.2)?;
-        let sheen = self.sheen_textures(job);
-        if let Some(t) = &sheen {
-            let cube = made.sheen.as_ref().ok_or_else(missing)?;
-            let tables = made.sheen_tables.as_ref().ok_or_else(missing)?;
-            self.gpu_copy(g, cube, job.specular_layout(), FACES, 4, &t.cube)?;
-            self.gpu_copy(g, tables, CubeLayout::new(crate::table::SHEEN_TABLE_SIZE, 1), 1, 2, &t.tables)?;
+        for (p, (texture, layout, layers, channels)) in &textures {
+            let texels = made.cube(*p).or(made.table(*p)).ok_or_else(|| Error::Invalid(format!("a display bake made no {p}")))?;
+            self.gpu_copy(g, texels, *layout, *layers, *channels, texture)?;
         }
-        Ok(self.ibl(job, textures, sheen, made.timings))
+        self.ibl(job, textures, made.timings)
     }
 
     /// Packs every level of `texels` (laid out as `layout` with `layers` layers) into
@@ -302,8 +296,7 @@ impl Baker {
 
     /// Packs host products into halves (the same function the kernel runs) and writes
     /// them into new textures.
-    fn upload(&self, baked: &Baked, job: &Job) -> Ibl {
-        let textures = self.textures(job);
+    fn upload(&self, baked: &Baked, job: &Job) -> Result<Ibl> {
         let write = |texture: &wgpu::Texture, texels: &[Vec4], layout: CubeLayout, layers: u32, channels: u32| {
             for m in 0..layout.levels {
                 let s = layout.level_size(m);
@@ -321,18 +314,18 @@ impl Baker {
                 );
             }
         };
-        let (spec, irr, lut) = (baked.specular.as_ref().expect("baked"), baked.irradiance.as_ref().expect("baked"), baked.lut.as_ref().expect("baked"));
-        write(&textures.0, &spec.texels, spec.layout, FACES, 4);
-        write(&textures.1, &irr.texels, irr.layout, FACES, 4);
-        let table: Vec<Vec4> = lut.texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect();
-        write(&textures.2, &table, CubeLayout::new(lut.size, 1), 1, 2);
-        let sheen = self.sheen_textures(job);
-        if let (Some(t), Some(cube), Some(tables)) = (&sheen, &baked.sheen, &baked.sheen_tables) {
-            write(&t.cube, &cube.texels, cube.layout, FACES, 4);
-            let texels: Vec<Vec4> = tables.texels.iter().map(|v| v.extend(0.0).extend(0.0)).collect();
-            write(&t.tables, &texels, CubeLayout::new(tables.size, 1), 1, 2);
+        let textures = self.textures(job);
+        for (p, (texture, layout, layers, channels)) in &textures {
+            match (baked.cube(*p), baked.table(*p)) {
+                (Some(cube), _) => write(texture, &cube.texels, *layout, *layers, *channels),
+                (None, Some(table)) => {
+                    let texels: Vec<Vec4> = table.texels.iter().map(|t| t.extend(0.0).extend(0.0)).collect();
+                    write(texture, &texels, *layout, *layers, *channels);
+                }
+                (None, None) => return Err(Error::Invalid(format!("a display bake made no {p}"))),
+            }
         }
-        self.ibl(job, textures, sheen, baked.timings.clone())
+        self.ibl(job, textures, baked.timings.clone())
     }
 
     /// Copies mip 0 of `texture` (every layer) into a buffer of 256-byte-aligned rows:
@@ -527,24 +520,18 @@ impl Ibl {
             let texels = if gpu::copies_cubes(device) { read_halves(device, queue, t, 4).await? } else { read_cube(device, queue, t, layout).await? };
             Ok(Cube { layout, texels })
         };
-        let size = self.brdf.size().width;
-        let brdf = Lut { size, texels: read_halves(device, queue, &self.brdf, 2).await?.into_iter().map(|v| v.truncate().truncate()).collect() };
-        Ok(Baked {
-            source: None,
-            specular: Some(cube(&self.specular).await?),
-            irradiance: Some(cube(&self.irradiance).await?),
-            sh9: None,
-            lut: Some(brdf),
-            sheen: match &self.sheen {
-                Some(t) => Some(cube(&t.cube).await?),
-                None => None,
-            },
-            sheen_tables: match &self.sheen {
-                Some(t) => Some(Lut { size: t.tables.size().width, texels: read_halves(device, queue, &t.tables, 2).await?.into_iter().map(|v| v.truncate().truncate()).collect() }),
-                None => None,
-            },
-            timings: self.timings.clone(),
-        })
+        let table = async |t: &wgpu::Texture| -> Result<Lut> {
+            Ok(Lut { size: t.size().width, texels: read_halves(device, queue, t, 2).await?.into_iter().map(|v| v.truncate().truncate()).collect() })
+        };
+        let mut baked = Baked::new(self.timings.clone());
+        baked.insert(Product::Specular, Item::Cube(cube(&self.specular).await?));
+        baked.insert(Product::Irradiance, Item::Cube(cube(&self.irradiance).await?));
+        baked.insert(Product::BrdfTable, Item::Table(table(&self.brdf).await?));
+        if let Some(t) = &self.sheen {
+            baked.insert(Product::Sheen, Item::Cube(cube(&t.cube).await?));
+            baked.insert(Product::SheenTables, Item::Table(table(&t.tables).await?));
+        }
+        Ok(baked)
     }
 }
 

@@ -162,7 +162,7 @@ fn khronos_target_matches_gltf_ibl_sampler() {
     let kc = read_ktx2(&kcharlie);
     let sc = read_ktx2(&out.join("charlie/sheen.ktx2"));
     assert_eq!((sc.size, sc.faces, sc.levels.len()), (kc.size, kc.faces, kc.levels.len()), "sheen: same size, faces and mip count");
-    let sheen_r: Vec<f64> = manifest["settings"]["sheen_roughness_per_mip"].as_array().unwrap().iter().map(|r| r.as_f64().unwrap()).collect();
+    let sheen_r: Vec<f64> = manifest["settings"]["prefiltered"]["sheen"]["roughness_per_mip"].as_array().unwrap().iter().map(|r| r.as_f64().unwrap()).collect();
     let half: Vec<splitsum_shaders::glam::Vec4> = (0..6u32)
         .flat_map(|f| (0..64u32).flat_map(move |y| (0..64u32).map(move |x| (f, x, y))))
         .map(|(f, x, y)| (0..4).map(|k| cube[((f * s + 2 * y + k / 2) * s + 2 * x + k % 2) as usize]).sum::<splitsum_shaders::glam::Vec4>() * 0.25)

@@ -27,7 +27,7 @@ use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum::cost::{Calibration, Cost};
 use splitsum::estimate::built_in_cost;
 use splitsum::error::Result;
-use splitsum::settings::{InputShape, Job, Products, Settings, TableMethod};
+use splitsum::settings::{InputShape, Job, Product, Products, Settings, TableMethod};
 use splitsum_shaders::shade::SpecularModel;
 
 
@@ -89,7 +89,7 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     if !uses.lit.is_empty() {
         d.push(Decision { subject: Subject::Sh9, kept: false, cause: Cause::Sh9Unread });
     }
-    let products = Products { specular, irradiance, sh9: false, lut, sheen };
+    let products = Products::of(&[]).with(Product::Specular, specular).with(Product::Irradiance, irradiance).with(Product::BrdfTable, lut).with(Product::Sheen, sheen);
 
     // Samples, bias, table, irradiance source.
     let q = &scene.quality;
@@ -114,7 +114,7 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
         None => irradiance_source(q, irradiance, cal, source_size, &mut d).or(settings.irradiance_source),
     };
 
-    let job = settings.resolve(shape, products)?.with_levels(levels)?.with_sheen_levels(sheen_levels)?;
+    let job = settings.resolve(shape, products)?.with_levels(Product::Specular, levels)?.with_levels(Product::Sheen, sheen_levels)?;
     let cost = built_in_cost(&job);
     let full_cost = built_in_cost(&settings.resolve(shape, Products::DISPLAY)?);
     let default_cost = built_in_cost(&Settings::default().resolve(shape, Products::STANDARD)?);
@@ -265,7 +265,7 @@ fn sheen(scene: &Scene, uses: &Uses<'_>, mips: u32, d: &mut Vec<Decision>) -> Re
     }
     let levels: Vec<u32> = read.into_iter().collect();
     if !levels.is_empty() {
-        let mips_read = levels.iter().map(|&l| (l, splitsum::settings::SHEEN_MAPPING.roughness(l, mips))).collect();
+        let mips_read = levels.iter().map(|&l| (l, Product::Sheen.mapping(RoughnessMapping::Linear).roughness(l, mips))).collect();
         let whose = names(&uses.sheen).into_iter().chain(model_sheen.iter().map(|p| format!("{} (KHR_materials_sheen)", p.display()))).collect();
         d.push(Decision { subject: Subject::Sheen, kept: true, cause: Cause::SheenOf { whose, mips: mips_read } });
     } else if !uses.lit.is_empty() {
@@ -277,7 +277,7 @@ fn sheen(scene: &Scene, uses: &Uses<'_>, mips: u32, d: &mut Vec<Decision>) -> Re
 /// A time budget: the lowest predicted error over the roughness the scene reads that fits
 /// (estimated on lavapipe's built-in rates, for the levels the plan keeps).
 fn time_budget(settings: &mut Settings, shape: InputShape, products: Products, budget: f64, cal: &Calibration, needed_r: &[f32], levels: &[u32], d: &mut Vec<Decision>) -> Result<()> {
-    let seconds = |job: &splitsum::Job| job.clone().with_levels(levels.to_vec()).map_or(f64::INFINITY, |j| splitsum::estimate::step_seconds(&j, true).total());
+    let seconds = |job: &splitsum::Job| job.clone().with_levels(Product::Specular, levels.to_vec()).map_or(f64::INFINITY, |j| splitsum::estimate::step_seconds(&j, true).total());
     let (chosen, error, estimate) = splitsum::cost::for_budget_by(settings, shape, products, budget, cal, Some(needed_r), seconds)?;
     let cause = Cause::Budget { samples: chosen.samples, irradiance_source: chosen.irradiance_source.unwrap_or_default(), error, estimate, budget };
     d.push(Decision { subject: Subject::TimeBudget, kept: true, cause });
@@ -348,13 +348,13 @@ pub fn describe(plan: &Plan, scene: &str, environment: &str) -> String {
     let s = &plan.job;
     let p = s.products;
     let mut kept = vec![format!("source {}²", s.source_size)];
-    if p.specular {
+    if p.has(Product::Specular) {
         kept.push(format!("specular {}² × {} mips ({:?}), {} samples, bias {}", s.size, s.mips, s.mapping, s.samples, s.lod_bias));
     }
-    if p.lut {
+    if p.has(Product::BrdfTable) {
         kept.push(format!("table {}", s.table_description()));
     }
-    if p.irradiance {
+    if p.has(Product::Irradiance) {
         kept.push(format!("irradiance {}² from {}²", s.irradiance_size, s.irradiance_source));
     }
     let _ = writeln!(out, "  settings: {}", kept.join("; "));

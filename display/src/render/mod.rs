@@ -5,6 +5,7 @@
 mod meshes;
 pub use meshes::{DEPTH_FORMAT, DEPTH_RANGE, GpuModel, GpuPrimitive};
 
+use splitsum::Product;
 use crate::model::Model;
 use rayon::prelude::*;
 use splitsum::backend::gpu::{Gpu, group_entries, group_layout};
@@ -263,7 +264,7 @@ pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
     out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
         for (x, p) in row.iter_mut().enumerate() {
             let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            *p = scene::pixel(frame, env.source.level(0), &env.specular.texels, &env.irradiance.texels, &env.lut.texels, &env.sheen.texels, &env.sheen_tables.texels, px);
+            *p = scene::pixel(frame, env.cube(Product::SourceCube).level(0), &env.cube(Product::Specular).texels, &env.cube(Product::Irradiance).texels, &env.table(Product::BrdfTable).texels, &env.cube(Product::Sheen).texels, &env.table(Product::SheenTables).texels, px);
         }
     });
     out
@@ -296,12 +297,12 @@ impl GpuScene {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let specular = gpu.upload_bytes("specular", bytemuck::cast_slice(&env.specular.texels));
-        let irradiance = gpu.upload_bytes("irradiance", bytemuck::cast_slice(&env.irradiance.texels));
-        let lut = gpu.upload_bytes("brdf lut", bytemuck::cast_slice(&env.lut.texels));
-        let source = gpu.upload_bytes("source", bytemuck::cast_slice(env.source.level(0)));
-        let sheen = gpu.upload_bytes("sheen", bytemuck::cast_slice(&env.sheen.texels));
-        let sheen_tables = gpu.upload_bytes("sheen tables", bytemuck::cast_slice(&env.sheen_tables.texels));
+        let specular = gpu.upload_bytes("specular", bytemuck::cast_slice(&env.cube(Product::Specular).texels));
+        let irradiance = gpu.upload_bytes("irradiance", bytemuck::cast_slice(&env.cube(Product::Irradiance).texels));
+        let lut = gpu.upload_bytes("brdf lut", bytemuck::cast_slice(&env.table(Product::BrdfTable).texels));
+        let source = gpu.upload_bytes("source", bytemuck::cast_slice(env.cube(Product::SourceCube).level(0)));
+        let sheen = gpu.upload_bytes("sheen", bytemuck::cast_slice(&env.cube(Product::Sheen).texels));
+        let sheen_tables = gpu.upload_bytes("sheen tables", bytemuck::cast_slice(&env.table(Product::SheenTables).texels));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("scene"),
             layout: &layout,

@@ -1,7 +1,7 @@
 //! `runner bake`: an environment, or a scene's plan, into an output folder.
 
 use super::*;
-use crate::settings::InputShape;
+use crate::settings::{InputShape, Product};
 use crate::{bake, output};
 
 #[derive(Args)]
@@ -236,17 +236,18 @@ fn write_scene_bake(out: &files::OutputDir, sb: &crate::prepare::SceneBake, form
     let job = &p.job;
     let mut written = Vec::new();
     let mut specular_roughness = Vec::new();
-    if let (true, Some(&first), Some(&last)) = (job.products.specular, job.levels.first(), job.levels.last()) {
-        crate::ktx2::write(&dir.join("specular.ktx2"), &sb.env.specular.levels(first, last), *format)?;
-        specular_roughness = (first..=last).map(|l| if job.levels.contains(&l) { Some(job.roughness_per_mip[l as usize]) } else { None }).collect();
+    let specular = &job.prefiltered[&Product::Specular];
+    if let (true, Some(&first), Some(&last)) = (job.products.has(Product::Specular), specular.levels.first(), specular.levels.last()) {
+        crate::ktx2::write(&dir.join("specular.ktx2"), &sb.env.cube(Product::Specular).levels(first, last), *format)?;
+        specular_roughness = (first..=last).map(|l| if specular.levels.contains(&l) { Some(specular.roughness_per_mip[l as usize]) } else { None }).collect();
         written.push("specular.ktx2");
     }
-    if job.products.irradiance {
-        crate::ktx2::write(&dir.join("irradiance.ktx2"), &sb.env.irradiance, *format)?;
+    if job.products.has(Product::Irradiance) {
+        crate::ktx2::write(&dir.join("irradiance.ktx2"), sb.env.cube(Product::Irradiance), *format)?;
         written.push("irradiance.ktx2");
     }
-    if job.products.lut {
-        files::write_lut_exr(&dir.join("brdf_lut.exr"), &sb.env.lut)?;
+    if job.products.has(Product::BrdfTable) {
+        files::write_lut_exr(&dir.join("brdf_lut.exr"), sb.env.table(Product::BrdfTable))?;
         written.push("brdf_lut.exr");
     }
     #[derive(serde::Serialize)]

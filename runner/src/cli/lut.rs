@@ -1,7 +1,7 @@
 //! `runner lut`: the split-sum BRDF table alone.
 
 use super::*;
-use crate::settings::Step;
+use crate::settings::Product;
 
 #[derive(Args)]
 pub(super) struct LutArgs {
@@ -57,13 +57,13 @@ pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
     };
     let in_flags = |e| in_flags(e, &lut_flag);
     let settings = Settings { lut_size: args.size, lut_samples: args.samples, lut_method: args.method, lut_masking: args.masking, ..Settings::default() };
-    let only_table = Products { specular: false, irradiance: false, sh9: false, lut: true, sheen: false };
+    let only_table = Products::of(&[Product::BrdfTable]);
     let job = settings.resolve(crate::settings::InputShape::Unknown, only_table).map_err(in_flags)?;
     let backend = Backend::open(args.backend)?;
     let start = Instant::now();
     // A table alone needs no source cube: its own step's estimate is the run's.
     let mut table = crate::cost::PerStep::default();
-    table[Step::BrdfTable] = splitsum::estimate::step_seconds(&job, backend.is_gpu())[Step::BrdfTable];
+    table[Product::BrdfTable] = splitsum::estimate::step_seconds(&job, backend.is_gpu())[Product::BrdfTable];
     crate::bake::check_duration(&table, args.force).map_err(in_flags)?;
     let lut = match job.lut_method {
         TableMethod::Quadrature => backend.brdf_table(job.lut_size, job.lut_masking),

@@ -1,7 +1,7 @@
 //! `runner report`: error against run time of every product and of the shaded colour.
 
 use super::*;
-use splitsum::measured::{Knob, Measurement, Method, Metric, Product, Set};
+use splitsum::measured::{Knob, Measurement, Method, Metric, Quantity, Set};
 
 #[derive(Args)]
 pub(super) struct ReportArgs {
@@ -80,7 +80,7 @@ fn ladder_costs(env: &environment::Environment, backends: &[Backend], quick: boo
                 ns_per_pixel: Some(ns),
                 mean_error: f64::NAN,
                 max_error: f64::NAN,
-                ..device.row(Product::ShadingCost, method, &[], Metric::RelativeLuminance)
+                ..device.row(Quantity::ShadingCost, method, &[], Metric::RelativeLuminance)
             });
         }
     }

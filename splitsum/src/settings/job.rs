@@ -10,7 +10,9 @@ use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::equirect::Facing;
+use crate::product::{Layout, Product};
 use splitsum_shaders::prefilter::{self, Lobe, RoughnessMapping};
+use std::collections::BTreeMap;
 
 /// The values [`Settings::resolve`] derives.
 pub(super) struct JobValues {
@@ -82,21 +84,12 @@ pub struct Job {
     /// KTX2 texel format.
     #[serde(with = "named")]
     pub format: Format,
-    /// The specular levels baked (all, unless a plan keeps fewer; the others stay zero).
-    pub levels: Vec<u32>,
-    /// The sheen levels baked (all, unless a plan keeps fewer; the others stay zero).
-    pub sheen_levels: Vec<u32>,
-    /// Roughness of each specular mip.
-    pub roughness_per_mip: Vec<f32>,
-    /// Sheen roughness of each mip of the sheen cube (linear: `settings::SHEEN_MAPPING`; it has the
-    /// specular cube's size and mips).
-    pub sheen_roughness_per_mip: Vec<f32>,
-    /// The source level each sheen mip is summed over exactly, or `prefilter::SAMPLED`.
-    pub sheen_exact_levels: Vec<u32>,
-    /// GGX samples per texel of each specular mip (capped at 2²⁰).
+    /// Each prefiltered cube (`Product::lobe`: the specular cube, the sheen cube), baked or
+    /// not: its roughness per mip, the mips baked, the exact sums. Both have the specular
+    /// cube's size and mips.
+    pub prefiltered: BTreeMap<Product, Prefiltered>,
+    /// Samples per texel of each mip of a prefiltered cube (capped at 2²⁰).
     pub samples_per_mip: Vec<u32>,
-    /// The source level each mip is summed over exactly, or `prefilter::SAMPLED`.
-    pub exact_levels: Vec<u32>,
     /// Equirect → cube supersamples per texel side (1 for a cube input).
     pub supersample: u32,
 }
@@ -127,13 +120,8 @@ impl Job {
             lut_method: given.lut_method,
             lut_masking: v.lut_masking,
             format: given.format,
-            levels: (0..v.mips).collect(),
-            sheen_levels: (0..v.mips).collect(),
-            roughness_per_mip: (0..v.mips).map(|m| v.mapping.roughness(m, v.mips)).collect(),
-            sheen_roughness_per_mip: (0..v.mips).map(|m| SHEEN_MAPPING.roughness(m, v.mips)).collect(),
+            prefiltered: BTreeMap::new(),
             samples_per_mip: Vec::new(),
-            exact_levels: Vec::new(),
-            sheen_exact_levels: Vec::new(),
             supersample: match input {
                 InputShape::Equirect { width, .. } => splitsum_shaders::equirect::supersampling(v.source_size, width, given.supersample_density),
                 _ => 1,
@@ -141,28 +129,45 @@ impl Job {
             given,
         };
         job.samples_per_mip = job.asked_samples_per_mip().into_iter().map(|n| n.min(MAX_SAMPLES as u64) as u32).collect();
-        job.exact_levels = exact_levels(Lobe::Ggx, &job.roughness_per_mip, &job.samples_per_mip, job.exact_sums, job.source_layout());
-        job.sheen_exact_levels = exact_levels(Lobe::Charlie, &job.sheen_roughness_per_mip, &job.samples_per_mip, job.exact_sums, job.source_layout());
+        for p in Product::ALL {
+            let Some(lobe) = p.lobe() else { continue };
+            let mapping = p.mapping(job.mapping);
+            let roughness_per_mip: Vec<f32> = (0..job.mips).map(|m| mapping.roughness(m, job.mips)).collect();
+            let exact_levels = exact_levels(lobe, &roughness_per_mip, &job.samples_per_mip, job.exact_sums, job.source_layout());
+            job.prefiltered.insert(p, Prefiltered { mapping, roughness_per_mip, levels: (0..job.mips).collect(), exact_levels });
+        }
         job
     }
 
-    /// This job baking only `levels` of the specular cube (the others stay zero): what a
-    /// scene's plan keeps. Refuses a level the cube does not have.
-    pub fn with_levels(mut self, levels: Vec<u32>) -> Result<Self> {
+    /// This job baking only `levels` of the prefiltered cube `cube` (the others stay zero):
+    /// what a scene's plan keeps. Refuses a level the cube does not have.
+    pub fn with_levels(mut self, cube: Product, levels: Vec<u32>) -> Result<Self> {
         if let Some(&m) = levels.iter().find(|&&m| m >= self.mips) {
-            return Err(Error::setting(Field::Mips, format!("has no mip {m} to bake (there are {})", self.mips)));
+            return Err(Error::setting(Field::Mips, format!("has no {cube} mip {m} to bake (there are {})", self.mips)));
         }
-        self.levels = levels;
+        self.prefiltered.get_mut(&cube).expect("a prefiltered cube").levels = levels;
         Ok(self)
     }
 
-    /// This job baking only `levels` of the sheen cube (the others stay zero).
-    pub fn with_sheen_levels(mut self, levels: Vec<u32>) -> Result<Self> {
-        if let Some(&m) = levels.iter().find(|&&m| m >= self.mips) {
-            return Err(Error::setting(Field::Mips, format!("has no sheen mip {m} to bake (there are {})", self.mips)));
+    internal! {
+        /// Where product `p`'s texels lie: a prefiltered cube (any lobe) has the specular cube's
+        /// layout.
+        pub fn layout(&self, p: Product) -> Layout {
+            match p {
+                Product::SourceCube => Layout::Cube(self.source_layout()),
+                p if p.lobe().is_some() => Layout::Cube(self.specular_layout()),
+                Product::Irradiance => Layout::Cube(self.irradiance_layout()),
+                Product::BrdfTable => Layout::Table(self.lut_size),
+                Product::SheenTables => Layout::Table(crate::product::SHEEN_TABLE_SIZE),
+                Product::Sh9 => Layout::Coefficients,
+                Product::Specular | Product::Sheen => unreachable!("a prefiltered cube"),
+            }
         }
-        self.sheen_levels = levels;
-        Ok(self)
+    }
+
+    /// Roughness of each mip of the specular cube.
+    pub fn roughness_per_mip(&self) -> &[f32] {
+        &self.prefiltered[&Product::Specular].roughness_per_mip
     }
 
     /// `samples × sample_growth^(m−1)` per mip, before the cap.
@@ -208,10 +213,11 @@ impl Job {
     /// a source cube finer than the environment resolves.
     pub fn adjustments(&self) -> Vec<Adjustment> {
         let mut out = Vec::new();
+        let specular = &self.prefiltered[&Product::Specular];
         for (mip, asked) in self.asked_samples_per_mip().into_iter().enumerate() {
             // The mirror and a mip summed exactly take no samples.
-            let sampled = self.roughness_per_mip[mip] > 0.0 && self.exact_levels[mip] == prefilter::SAMPLED;
-            if sampled && self.products.specular && asked > self.samples_per_mip[mip] as u64 {
+            let sampled = specular.roughness_per_mip[mip] > 0.0 && specular.exact_levels[mip] == prefilter::SAMPLED;
+            if sampled && self.products.has(Product::Specular) && asked > self.samples_per_mip[mip] as u64 {
                 out.push(Adjustment::SamplesCapped { mip: mip as u32, asked, used: self.samples_per_mip[mip] });
             }
         }
@@ -225,11 +231,6 @@ impl Job {
     }
 }
 
-/// How the sheen cube's mips map to sheen roughness, whatever the target: linear, as the
-/// glTF Sample Viewer reads it (`getIBLRadianceCharlie`: `lod = sheenRoughness ·
-/// (u_MipCount − 1)`) and glTF-IBL-Sampler writes it.
-pub const SHEEN_MAPPING: RoughnessMapping = RoughnessMapping::Linear;
-
 /// The source level each level of a `lobe` cube is summed over exactly, or
 /// `prefilter::SAMPLED`: with `exact`, wherever that costs less than its samples
 /// (`prefilter::exact_level`).
@@ -240,4 +241,20 @@ pub fn exact_levels(lobe: Lobe, roughness: &[f32], samples: &[u32], exact: bool,
 /// The source level whose faces are `face` wide (or the smallest there is).
 pub fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
     (0..layout.levels).find(|&l| layout.level_size(l) <= face).unwrap_or(layout.levels - 1)
+}
+
+/// One prefiltered cube of a job (the specular cube, the sheen cube): which roughness each
+/// mip holds and how each is made. Every lobe of [`Product::ALL`] has one in
+/// `Job::prefiltered`, baked or not.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Prefiltered {
+    /// The roughness each mip holds.
+    #[serde(with = "named")]
+    pub mapping: RoughnessMapping,
+    /// Roughness of each mip.
+    pub roughness_per_mip: Vec<f32>,
+    /// The mips baked (all, unless a plan keeps fewer; the others stay zero).
+    pub levels: Vec<u32>,
+    /// The source level each mip is summed over exactly, or `prefilter::SAMPLED`.
+    pub exact_levels: Vec<u32>,
 }

@@ -3,7 +3,8 @@
 //! the files follow).
 
 pub use crate::environment::InputShape;
-pub use crate::field::{Field, Step};
+pub use crate::field::Field;
+pub use crate::product::{Product, Products};
 use crate::error::{Error, Result};
 use crate::texture::Format;
 use serde::{Deserialize, Serialize};
@@ -14,7 +15,7 @@ use splitsum_shaders::prefilter::RoughnessMapping;
 
 mod job;
 mod target;
-pub use job::{Job, SHEEN_MAPPING, exact_levels, level_of_size};
+pub use job::{Job, exact_levels, level_of_size};
 use job::JobValues;
 pub use target::{Fixed, Target};
 
@@ -293,21 +294,21 @@ impl Settings {
         let mips = self.mips.or(self.target.fixed().mips.map(|m| m(self.size))).unwrap_or_else(|| Self::default_mips(self.size));
         let mut out = Vec::new();
         let mut add = |fields: &[Field], why: Unread| out.extend(fields.iter().map(|f| (*f, why)));
-        if !products.lut {
+        if !products.has(Product::BrdfTable) {
             add(&[Field::LutSize, Field::LutMethod, Field::LutMasking, Field::LutSamples], Unread::NoTable);
         } else if self.lut_method == TableMethod::Quadrature {
             add(&[Field::LutSamples], Unread::QuadratureTable);
         }
-        if !products.irradiance {
+        if !products.has(Product::Irradiance) {
             add(&[Field::IrradianceSize, Field::IrradianceSource], Unread::NoIrradiance);
         }
-        if !products.sh9 {
+        if !products.has(Product::Sh9) {
             add(&[Field::ShSource], Unread::NoSh9);
         }
         if cube_input {
             add(&[Field::SupersampleDensity], Unread::CubeInput);
         }
-        if !products.specular || mips == 1 {
+        if !products.has(Product::Specular) || mips == 1 {
             add(&[Field::Samples, Field::SampleGrowth, Field::LodBias, Field::ExactSums], Unread::MirrorOnly);
         } else if mips == 2 {
             add(&[Field::SampleGrowth], Unread::NoGrowth);
@@ -351,32 +352,3 @@ impl Unread {
     }
 }
 
-/// Which products to bake.
-#[derive(Copy, Clone, Debug, PartialEq, Eq, Serialize)]
-pub struct Products {
-    /// The sheen cube (Charlie-prefiltered radiance) and the sheen tables.
-    pub sheen: bool,
-    /// The prefiltered specular cube.
-    pub specular: bool,
-    /// The irradiance cube.
-    pub irradiance: bool,
-    /// The SH9 coefficients.
-    pub sh9: bool,
-    /// The BRDF table.
-    pub lut: bool,
-}
-
-impl Products {
-    /// Everything.
-    pub const ALL: Products = Products { specular: true, irradiance: true, sh9: true, lut: true, sheen: true };
-    /// Everything but sheen: splitsum's own folder unless sheen is asked for.
-    pub const STANDARD: Products = Products { sheen: false, ..Products::ALL };
-    /// What a renderer reads for materials without sheen: the specular cube, the
-    /// irradiance cube and the BRDF table.
-    pub const DISPLAY: Products = Products { specular: true, irradiance: true, sh9: false, lut: true, sheen: false };
-
-    /// These products, and the sheen cube and tables if `sheen`.
-    pub fn with_sheen(self, sheen: bool) -> Products {
-        Products { sheen: self.sheen || sheen, ..self }
-    }
-}

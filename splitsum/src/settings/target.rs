@@ -76,9 +76,9 @@ impl Target {
     pub fn products(self) -> Products {
         match self {
             Target::Splitsum => Products::STANDARD,
-            Target::Khronos => Products { sheen: true, ..Products::DISPLAY },
+            Target::Khronos => Products::DISPLAY.with(Product::Sheen, true),
             Target::Bevy => Products::DISPLAY,
-            Target::Filament => Products { specular: true, irradiance: false, sh9: true, lut: false, sheen: false },
+            Target::Filament => Products::of(&[Product::Specular, Product::Sh9]),
         }
     }
 }

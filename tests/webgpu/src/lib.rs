@@ -2,7 +2,7 @@
 
 use splitsum::glam::Vec4;
 use splitsum::texture::Equirect;
-use splitsum::{Baker, Compute, Environment, Settings, Source};
+use splitsum::{Baker, Compute, Environment, Product, Settings, Source};
 use wasm_bindgen::prelude::*;
 
 #[wasm_bindgen]
@@ -42,9 +42,9 @@ pub async fn bake(texels: Vec<f32>, width: u32, height: u32, size: u32) -> Resul
     let baked = ibl.read_async(&device, &queue).await.map_err(err)?;
     console_log("read back");
     let mut out = Vec::new();
-    for cube in [baked.specular.as_ref(), baked.irradiance.as_ref()].into_iter().flatten() {
+    for cube in [baked.cube(Product::Specular), baked.cube(Product::Irradiance)].into_iter().flatten() {
         out.extend(cube.texels.iter().flat_map(|v| v.to_array()));
     }
-    out.extend(baked.lut.iter().flat_map(|l| l.texels.iter().flat_map(|t| t.to_array())));
+    out.extend(baked.table(Product::BrdfTable).iter().flat_map(|l| l.texels.iter().flat_map(|t| t.to_array())));
     Ok(out)
 }

@@ -1,0 +1,319 @@
+//! The product table: every product a bake can make is one variant of [`Product`], and
+//! what it is is read from here: its shape, its lobe (a prefiltered cube) and the roughness
+//! its mips hold, what it comes with, the fields that set its cost, its share of the cost
+//! model's limit and its operations per sample, its cache file, and its names in files and
+//! messages. [`Products`] is a set of them. This module depends on nothing but `field`.
+//!
+//! Everything downstream loops over [`Product::ALL`] or a [`Products`] set and reads the
+//! table, with one arm for every prefiltered lobe: `Job` (one `Prefiltered` per lobe, and
+//! `Job::layout`), the bake sequence and `read` (`bake`), the work and bytes of each step
+//! (`cost`), the estimator, the splitsum folder (`output`), the cache and the textures.
+//! ARCHITECTURE.md walks through adding a lobe.
+
+use crate::field::Field;
+use crate::texture::Sh9;
+use serde::Serialize;
+use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::prefilter::{Lobe, RoughnessMapping};
+
+/// Texels per side of the sheen tables (`crate::table`). Both are smooth in n·v and in
+/// roughness (no kink inside a texel); the glTF Sample Viewer samples them bilinearly.
+pub const SHEEN_TABLE_SIZE: u32 = 64;
+
+/// A product of a bake, which is also its step: listed in the order a bake makes them.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Product {
+    /// The source cube with its mips (resampled from an equirect, or reduced faces).
+    SourceCube,
+    /// The GGX-prefiltered specular cube, one roughness per mip.
+    Specular,
+    /// The irradiance cube (`E/π`).
+    Irradiance,
+    /// The SH9 coefficients of radiance.
+    Sh9,
+    /// The split-sum BRDF table, `(A, B, 0, 0)` per texel.
+    BrdfTable,
+    /// The Charlie-prefiltered sheen cube, one sheen roughness per mip.
+    Sheen,
+    /// The sheen tables, `(Charlie table, sheen albedo, 0, 0)` per texel.
+    SheenTables,
+}
+
+/// What a product is made of.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// Cube texels.
+    Cube,
+    /// Table texels.
+    Table,
+    /// Coefficients.
+    Coefficients,
+}
+
+/// Where a product's texels lie.
+#[derive(Copy, Clone, Debug, PartialEq, Eq)]
+pub enum Layout {
+    /// A cube of this layout.
+    Cube(CubeLayout),
+    /// A square table this wide.
+    Table(u32),
+    /// Nine coefficients per colour channel ([`Sh9`]).
+    Coefficients,
+}
+
+/// A product as a backend made it: cube texels, table texels (`C`/`L`: the backend's
+/// texels, or host images), or SH9 coefficients (always in host memory).
+#[derive(Clone, Debug)]
+pub enum Item<C, L = C> {
+    /// A cube.
+    Cube(C),
+    /// A table.
+    Table(L),
+    /// SH9 coefficients.
+    Coefficients(Box<Sh9>),
+}
+
+impl Product {
+    /// Every product, in the order a bake makes them.
+    pub const ALL: [Product; 7] = [Product::SourceCube, Product::Specular, Product::Irradiance, Product::Sh9, Product::BrdfTable, Product::Sheen, Product::SheenTables];
+
+    internal! {
+        /// The number of products.
+        pub const COUNT: usize = Product::ALL.len();
+    }
+
+    internal! {
+        /// Its place in [`Product::ALL`].
+        pub fn index(self) -> usize {
+            self as usize
+        }
+    }
+
+    /// Its name, as progress and timings show it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Product::SourceCube => "source cube",
+            Product::Specular => "specular",
+            Product::Irradiance => "irradiance",
+            Product::Sh9 => "sh9",
+            Product::BrdfTable => "brdf lut",
+            Product::Sheen => "sheen",
+            Product::SheenTables => "sheen tables",
+        }
+    }
+
+    /// Its name in files and JSON (as serde writes it): `source_cube`, `brdf_table`, ….
+    pub fn key(self) -> &'static str {
+        match self {
+            Product::SourceCube => "source_cube",
+            Product::Specular => "specular",
+            Product::Irradiance => "irradiance",
+            Product::Sh9 => "sh9",
+            Product::BrdfTable => "brdf_table",
+            Product::Sheen => "sheen",
+            Product::SheenTables => "sheen_tables",
+        }
+    }
+
+    /// What it holds, in a few words (for the files' descriptions).
+    pub fn about(self) -> &'static str {
+        match self {
+            Product::SourceCube => "the environment as a cube with its mips",
+            Product::Specular => "GGX-prefiltered radiance",
+            Product::Irradiance => "irradiance divided by π",
+            Product::Sh9 => "SH9 coefficients of radiance",
+            Product::BrdfTable => "the split-sum BRDF table (A, B)",
+            Product::Sheen => "Charlie-prefiltered radiance (sheen)",
+            Product::SheenTables => "the sheen tables (Charlie table, sheen albedo)",
+        }
+    }
+
+    internal! {
+        /// Whether it is a cube, a table or coefficients ([`Layout`] without the sizes).
+        pub fn shape(self) -> Shape {
+            match self {
+                Product::SourceCube | Product::Specular | Product::Irradiance | Product::Sheen => Shape::Cube,
+                Product::BrdfTable | Product::SheenTables => Shape::Table,
+                Product::Sh9 => Shape::Coefficients,
+            }
+        }
+    }
+
+    internal! {
+        /// Its file in a cache entry (`crate::cache`).
+        pub fn cache_file(self) -> &'static str {
+            match self {
+                Product::SourceCube => "source.bin",
+                Product::Specular => "specular.bin",
+                Product::Irradiance => "irradiance.bin",
+                Product::Sh9 => "sh9.bin",
+                Product::BrdfTable => "lut.bin",
+                Product::Sheen => "sheen.bin",
+                Product::SheenTables => "sheen_tables.bin",
+            }
+        }
+    }
+
+    internal! {
+        /// The lobe a prefiltered cube is filtered with (`None`: not a prefiltered cube).
+        pub fn lobe(self) -> Option<Lobe> {
+            match self {
+                Product::Specular => Some(Lobe::Ggx),
+                Product::Sheen => Some(Lobe::Charlie),
+                _ => None,
+            }
+        }
+    }
+
+    internal! {
+        /// Floating-point operations per sample of a prefiltered cube's lobe, counted by
+        /// reading the shared functions once: about 140 per GGX sample (the half vector ≈ 50,
+        /// the lookup ≈ 70, the compensated sum ≈ 20), 330 per Charlie sample (its three Newton
+        /// steps ≈ 190 in place of the half vector's 50). For the cost model (`cost::work`).
+        pub fn flops_per_sample(self) -> f64 {
+            match self {
+                Product::Sheen => 330.0,
+                _ => 140.0,
+            }
+        }
+    }
+
+    internal! {
+        /// The roughness each mip of a prefiltered cube holds, given the specular cube's
+        /// (the target's): the sheen cube's is linear whatever the target, as the glTF Sample
+        /// Viewer reads it (`getIBLRadianceCharlie`: `lod = sheenRoughness · (u_MipCount − 1)`)
+        /// and glTF-IBL-Sampler writes it.
+        pub fn mapping(self, specular: RoughnessMapping) -> RoughnessMapping {
+            match self {
+                Product::Sheen => RoughnessMapping::Linear,
+                _ => specular,
+            }
+        }
+    }
+
+    /// What a bake of this product makes with it: a renderer that reads the sheen cube
+    /// reads the sheen tables too.
+    pub fn comes_with(self) -> Option<Product> {
+        match self {
+            Product::Sheen => Some(Product::SheenTables),
+            _ => None,
+        }
+    }
+
+    /// The fields that set the step's cost.
+    pub fn cost_fields(self) -> &'static [Field] {
+        match self {
+            Product::SourceCube => &[Field::SourceSize, Field::SupersampleDensity],
+            Product::Specular | Product::Sheen => &[Field::Samples, Field::SampleGrowth, Field::Size],
+            Product::Irradiance => &[Field::IrradianceSize, Field::IrradianceSource],
+            Product::Sh9 => &[Field::ShSource],
+            Product::BrdfTable => &[Field::LutSize, Field::LutSamples],
+            Product::SheenTables => &[],
+        }
+    }
+
+    internal! {
+        /// The share of its limit the step reaches on 2 CPU cores (`gpu` false) or on a GPU:
+        /// the median of limit/time over five quiet `runner bench --runs 1` of city.exr, with
+        /// and without `--sheen` (the tuning set; each a process of its own, calibrated as a
+        /// bake is, December 2026), confirmed on four held-out configurations (courtyard.exr,
+        /// studio.exr at 512², sunset.exr at 128², forest.exr for the khronos target); the GPU's
+        /// on lavapipe (no hardware GPU has been measured). The irradiance and SH9 steps take
+        /// under 50 ms here (no estimate is shown or learnt from): the summed reads' share of
+        /// lavapipe, rounded. The tables are uploaded constants: no work the limits measure.
+        pub fn share(self, gpu: bool) -> f64 {
+            match (self, gpu) {
+                (Product::SourceCube, false) => 0.52,
+                (Product::SourceCube, true) => 0.41,
+                (Product::Specular, false) => 1.01,
+                (Product::Specular, true) => 0.76,
+                (Product::Irradiance | Product::Sh9, false) => 0.6,
+                (Product::Irradiance | Product::Sh9, true) => 0.67,
+                (Product::Sheen, false) => 1.25,
+                (Product::Sheen, true) => 0.70,
+                (Product::BrdfTable | Product::SheenTables, _) => 1.0,
+            }
+        }
+    }
+
+}
+
+impl std::fmt::Display for Product {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A set of products: what a bake makes.
+#[derive(Copy, Clone, Debug, PartialEq, Eq, Hash)]
+pub struct Products(u32);
+
+impl Products {
+    /// Everything.
+    pub const ALL: Products = Products::of(&Product::ALL);
+    /// Everything but sheen: splitsum's own folder unless sheen is asked for.
+    pub const STANDARD: Products = Products::of(&[Product::SourceCube, Product::Specular, Product::Irradiance, Product::Sh9, Product::BrdfTable]);
+    /// What a renderer reads for materials without sheen: the specular cube, the
+    /// irradiance cube and the BRDF table (and the source cube, the sky).
+    pub const DISPLAY: Products = Products::of(&[Product::SourceCube, Product::Specular, Product::Irradiance, Product::BrdfTable]);
+    /// Nothing but the source cube, which every bake makes first.
+    pub const SOURCE: Products = Products::of(&[]);
+
+    /// The set of `products`, and the source cube, which every bake makes first.
+    pub const fn of(products: &[Product]) -> Products {
+        let mut bits = 1 << Product::SourceCube as u32;
+        let mut k = 0;
+        while k < products.len() {
+            bits |= 1 << products[k] as u32;
+            k += 1;
+        }
+        Products(bits)
+    }
+
+    /// Whether `p` is in the set.
+    pub fn has(self, p: Product) -> bool {
+        self.0 & (1 << p as u32) != 0
+    }
+
+    /// The set with `p` (and what it comes with, [`Product::comes_with`]) if `yes`.
+    pub fn with(self, p: Product, yes: bool) -> Products {
+        if !yes {
+            return self;
+        }
+        let with = Products(self.0 | 1 << p as u32);
+        match p.comes_with() {
+            Some(q) => with.with(q, true),
+            None => with,
+        }
+    }
+
+    /// The set without `p` (and what it comes with); never without the source cube.
+    pub fn without(self, p: Product) -> Products {
+        if p == Product::SourceCube {
+            return self;
+        }
+        let without = Products(self.0 & !(1 << p as u32));
+        match p.comes_with() {
+            Some(q) => without.without(q),
+            None => without,
+        }
+    }
+
+    /// These products, and the sheen cube and tables if `sheen`.
+    pub fn with_sheen(self, sheen: bool) -> Products {
+        self.with(Product::Sheen, sheen)
+    }
+
+    /// The products in the set, in the order a bake makes them.
+    pub fn iter(self) -> impl Iterator<Item = Product> {
+        Product::ALL.into_iter().filter(move |p| self.has(*p))
+    }
+}
+
+impl Serialize for Products {
+    /// As the list of the products' keys: `["source_cube", "specular", …]`.
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.collect_seq(self.iter().map(Product::key))
+    }
+}
