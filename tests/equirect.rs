@@ -187,3 +187,32 @@ fn reading_for_a_cube_reduces_the_image_and_keeps_its_power() {
 fn mean_relative(a: &[Vec4], b: &[Vec4]) -> f64 {
     a.iter().zip(b).map(|(x, y)| ((x.x - y.x).abs() / y.x.abs().max(1e-3)) as f64).sum::<f64>() / a.len() as f64
 }
+
+/// A step whose largest buffer is more than the device binds runs on the CPU, the others
+/// on the device (`splitsum::placement`, decided before the bake; the GPU executor has no
+/// fallback of its own). The row pyramid of a 4096×2048 equirect is 256 MiB, over the
+/// 128 MiB lavapipe binds: its source cube is the CPU's, bit for bit, and the products the
+/// device makes from it hold the GPU-vs-CPU bound of the prefilter (`prefilter.rs`).
+#[test]
+fn a_step_larger_than_the_device_binds_runs_on_the_cpu() {
+    use splitsum::placement::{Place, place};
+    let w = 4096u32; // env(w, …) is w × w/2
+    let env = splitsum::Environment::Equirect(env(w, |x, y| Vec4::new(1.0 + (x % 97) as f32 / 97.0, 0.5 + (y % 31) as f32 / 31.0, 2.0, 1.0)));
+    let settings = splitsum::Settings { size: 32, source_size: Some(64), irradiance_size: 8, lut_size: 16, ..Default::default() };
+    let job = settings.resolve(splitsum::InputShape::of(&env), splitsum::Products::DISPLAY).unwrap();
+    let splitsum::Backend::Gpu(g) = support::gpu() else { unreachable!("opened as a GPU") };
+    let on_host = matches!(place(Product::SourceCube, &job, Some(g.max_binding())), Place::Host { .. });
+    assert_eq!(place(Product::Specular, &job, Some(g.max_binding())), Place::Device, "the 32² cube's sums fit");
+    let gpu = splitsum::bake::bake_job(support::gpu(), &env, &job).unwrap();
+    let cpu = splitsum::bake::bake_job(&Backend::Cpu, &env, &job).unwrap();
+    let (gs, cs) = (gpu.cube(Product::SourceCube).unwrap(), cpu.cube(Product::SourceCube).unwrap());
+    if on_host {
+        assert!(gs.texels == cs.texels, "the source cube placed on the host is the CPU's");
+    } else {
+        println!("this device binds {} MiB: the source cube ran on it", g.max_binding() >> 20);
+    }
+    let rel = support::max_relative(&gpu.cube(Product::Specular).unwrap().texels, &cpu.cube(Product::Specular).unwrap().texels, 1e-3);
+    println!("4096×2048 → 64² source (on the {}), 32² specular on the device: gpu vs cpu max relative {rel:.2e}", if on_host { "CPU" } else { "device" });
+    let bound = support::gpu_bound(1e-5, 5e-5) as f32;
+    assert!(rel < bound, "{rel:e} (bound {bound:e})");
+}

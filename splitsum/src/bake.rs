@@ -4,7 +4,8 @@
 //! `crate::textures`); [`bake`] reads them into host memory ([`Baked`]) for files, reports
 //! and the CPU rasteriser. Everything else (plans, caches, the display) calls these.
 
-use crate::backend::{Backend, Kernels, Prefilter, with_kernels};
+use crate::backend::{Backend, Cpu, Kernels, Prefilter, with_kernels};
+use crate::placement::{self, Place};
 use crate::cost;
 use crate::estimate::Estimator;
 use crate::environment::Environment;
@@ -168,18 +169,45 @@ pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, job: &Job)
         ));
     }
     let full_layout = CubeLayout::new(face, CubeLayout::full_chain(face));
-    k.build_mips(&mut full, full_layout)?;
+    let place = placement::place_buffer(placement::texel_bytes(full_layout.texel_count() as u64), k.max_binding());
+    match place {
+        Place::Device => k.build_mips(&mut full, full_layout)?,
+        Place::Host { .. } => {
+            placement::note(&format!("the mips of the {face}² cube"), place, "the device");
+            let mut host = k.read(&full)?;
+            Cpu.build_mips(&mut host, full_layout)?;
+            full = k.upload("cube", &host)?;
+        }
+    }
     let start = full_layout.level_offset(crate::settings::level_of_size(full_layout, size));
     Ok((k.slice(&full, start, full_layout.texel_count() - start)?, job.source_layout()))
 }
 
 /// Bakes the products of `job` from a source cube already on backend `k`, each step
 /// estimated by `est`: every product of `job.products` after the source cube, in the order
-/// of [`Product::ALL`] (`Product::make`).
+/// of [`Product::ALL`], each where `crate::placement` places it: on `k`, or on the CPU
+/// (the source cube read back once, each result uploaded) where a buffer of the step is
+/// larger than `k` binds.
 pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout, job: &Job, est: &mut Estimator, timings: Vec<Timing>) -> Result<Made<K::Texels>> {
     let mut made = Made::new(timings);
+    let mut host_source: Option<Vec<splitsum_shaders::glam::Vec4>> = None;
     for p in job.products.iter().filter(|p| *p != Product::SourceCube) {
-        let item = timed(k, &mut made.timings, p, job, est, || make_product(k, p, &source, source_layout, job))?;
+        let place = placement::place(p, job, k.max_binding());
+        let item = timed(k, &mut made.timings, p, job, est, || match place {
+            Place::Device => make_product(k, p, &source, source_layout, job),
+            Place::Host { .. } => {
+                placement::note(&format!("the {p} step"), place, "the device");
+                let host = match &mut host_source {
+                    Some(h) => h,
+                    None => host_source.insert(k.read(&source)?),
+                };
+                Ok(match make_product(&Cpu, p, host, source_layout, job)? {
+                    Item::Cube(t) => Item::Cube(k.upload(p.name(), &t)?),
+                    Item::Table(t) => Item::Table(k.upload(p.name(), &t)?),
+                    Item::Coefficients(c) => Item::Coefficients(c),
+                })
+            }
+        })?;
         made.insert(p, item);
     }
     made.insert(Product::SourceCube, Item::Cube(source));
@@ -218,7 +246,15 @@ pub fn prefilter(job: &Job, p: Product) -> Prefilter<'_> {
 /// estimated by `est`.
 pub fn make<K: Kernels>(k: &K, est: &mut Estimator, env: &Environment, job: &Job) -> Result<Made<K::Texels>> {
     let mut timings = Vec::new();
-    let (source, layout) = timed(k, &mut timings, Product::SourceCube, job, est, || source_cube(k, env, job))?;
+    let place = placement::place(Product::SourceCube, job, k.max_binding());
+    let (source, layout) = timed(k, &mut timings, Product::SourceCube, job, est, || match place {
+        Place::Device => source_cube(k, env, job),
+        Place::Host { .. } => {
+            placement::note("the source cube", place, "the device");
+            let (t, layout) = source_cube(&Cpu, env, job)?;
+            Ok((k.upload("source cube", &t)?, layout))
+        }
+    })?;
     self::products(k, source, layout, job, est, timings)
 }
 

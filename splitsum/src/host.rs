@@ -1,9 +1,11 @@
 //! Host-data conveniences over the backends, for reports, tests and tools: each runs one
 //! operation of [`Kernels`] on data in host memory and reads the result back, with its
-//! arguments checked by the one validation (`Settings::resolve`).
+//! arguments checked by the one validation (`Settings::resolve`), on the CPU where its
+//! buffers are larger than the device binds (`crate::placement`).
 
 use crate::backend::{Backend, Kernels, Prefilter, with_kernels};
 use crate::error::{Error, Result};
+use crate::placement::{self, Place, texel_bytes};
 use crate::settings::{Field, Settings};
 use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
@@ -19,11 +21,29 @@ fn check_lut_args(size: u32, samples: u32) -> Result<()> {
 }
 
 impl Backend {
+    /// Runs `f` on this backend, or on the CPU where an operation whose largest buffer is
+    /// `needs` bytes does not fit one storage binding of this device (`crate::placement`).
+    fn placed<T>(&self, what: &str, needs: u64, f: impl FnOnce(&Backend) -> T) -> T {
+        let binds = match self {
+            Backend::Cpu => None,
+            Backend::Gpu(g) => Some(g.max_binding()),
+        };
+        match placement::place_buffer(needs, binds) {
+            Place::Device => f(self),
+            place => {
+                placement::note(what, place, "the device");
+                f(&Backend::Cpu)
+            }
+        }
+    }
+
     internal! {
         /// The `size`×`size` BRDF table from `samples` points per texel.
         pub fn brdf_lut(&self, size: u32, samples: u32) -> Result<Lut> {
             check_lut_args(size, samples)?;
-            with_kernels!(self, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_lut(size, samples)?)?)))
+            self.placed("the BRDF table", texel_bytes((size as u64).pow(2)), |b| {
+                with_kernels!(b, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_lut(size, samples)?)?)))
+            })
         }
     }
 
@@ -32,7 +52,9 @@ impl Backend {
         /// (`lut::integrate_brdf_quadrature`).
         pub fn brdf_table(&self, size: u32, masking: Masking) -> Result<Lut> {
             check_lut_args(size, 1)?;
-            with_kernels!(self, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_table(size, masking)?)?)))
+            self.placed("the BRDF table", texel_bytes((size as u64).pow(2)), |b| {
+                with_kernels!(b, k => Ok(Lut::from_texels(size, &k.read(&k.brdf_table(size, masking)?)?)))
+            })
         }
     }
 
@@ -41,18 +63,23 @@ impl Backend {
         /// texel, the image centre facing `facing`, and its full mip chain.
         pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Cube> {
             let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
-            with_kernels!(self, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, facing)?)? }))
+            let needs = texel_bytes(splitsum_shaders::equirect::pyramid_len(env.width, env.height) as u64).max(texel_bytes(layout.texel_count() as u64));
+            self.placed("resampling the equirect", needs, |b| {
+                with_kernels!(b, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, facing)?)? }))
+            })
         }
     }
 
     internal! {
         /// Fills levels 1.. of `cube` from its level 0.
         pub fn build_mips(&self, cube: &mut Cube) -> Result<()> {
-            with_kernels!(self, k => {
-                let mut t = k.upload("cube", &cube.texels)?;
-                k.build_mips(&mut t, cube.layout)?;
-                cube.texels = k.read(&t)?;
-                Ok(())
+            self.placed("the mips", texel_bytes(cube.texels.len() as u64), |b| {
+                with_kernels!(b, k => {
+                    let mut t = k.upload("cube", &cube.texels)?;
+                    k.build_mips(&mut t, cube.layout)?;
+                    cube.texels = k.read(&t)?;
+                    Ok(())
+                })
             })
         }
     }
@@ -88,9 +115,12 @@ impl Backend {
             }
             let exact = crate::settings::exact_levels(lobe, roughness, samples, exact, src.layout);
             let job = Prefilter { lobe, layout: out, roughness, levels, samples, exact: &exact, lod_bias };
-            with_kernels!(self, k => {
-                let t = k.upload("source cube", &src.texels)?;
-                Ok(Cube { layout: out, texels: k.read(&k.prefilter(&t, src.layout, &job)?)? })
+            let needs = texel_bytes(src.texels.len() as u64).max(3 * texel_bytes(out.texel_count() as u64));
+            self.placed("the prefiltered cube", needs, |b| {
+                with_kernels!(b, k => {
+                    let t = k.upload("source cube", &src.texels)?;
+                    Ok(Cube { layout: out, texels: k.read(&k.prefilter(&t, src.layout, &job)?)? })
+                })
             })
         }
     }
@@ -98,9 +128,12 @@ impl Backend {
     internal! {
         /// The irradiance cube (`E/π`) of face size `size` from level `level` of `src`.
         pub fn irradiance(&self, src: &Cube, level: u32, size: u32) -> Result<Cube> {
-            with_kernels!(self, k => {
-                let t = k.upload("source cube", &src.texels)?;
-                Ok(Cube { layout: CubeLayout::new(size, 1), texels: k.read(&k.irradiance(&t, src.layout, level, size)?)? })
+            let needs = texel_bytes(src.texels.len() as u64).max(3 * texel_bytes(CubeLayout::new(size, 1).texel_count() as u64));
+            self.placed("the irradiance", needs, |b| {
+                with_kernels!(b, k => {
+                    let t = k.upload("source cube", &src.texels)?;
+                    Ok(Cube { layout: CubeLayout::new(size, 1), texels: k.read(&k.irradiance(&t, src.layout, level, size)?)? })
+                })
             })
         }
     }
@@ -108,7 +141,7 @@ impl Backend {
     internal! {
         /// The nine SH coefficients of radiance of level `level` of `src`.
         pub fn sh9(&self, src: &Cube, level: u32) -> Result<Sh9> {
-            with_kernels!(self, k => k.sh9(&k.upload("source cube", &src.texels)?, src.layout, level))
+            self.placed("SH9", texel_bytes(src.texels.len() as u64), |b| with_kernels!(b, k => k.sh9(&k.upload("source cube", &src.texels)?, src.layout, level)))
         }
     }
 
@@ -136,7 +169,8 @@ impl Backend {
                 ProbeMode::Irradiance => FACES * layout.level_size(p.src_level).pow(2),
                 _ => 1,
             };
-            let raw = with_kernels!(self, k => k.probe_raw(p, texels, probes, terms))?;
+            let needs = texel_bytes((texels.len() + probes.len()) as u64).max(3 * texel_bytes(probes.len() as u64));
+            let raw = self.placed("the probes", needs, |b| with_kernels!(b, k => k.probe_raw(p, texels, probes, terms)))?;
             let partial = |i: usize| splitsum_shaders::math::MeanPartial { sum: raw[3 * i], carry: raw[3 * i + 1], weight: raw[3 * i + 2] };
             Ok(raw
                 .chunks_exact(3)

@@ -94,6 +94,7 @@ internal_modules! {
     ktx1;
     ktx2;
     measured;
+    placement;
     preview;
     product;
     settings;

@@ -28,7 +28,6 @@ use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::half::{clean_radiance, copied_texel, f16_bits_to_f32, pack_radiance};
 use splitsum_shaders::kernels::RowsParams;
 use splitsum_shaders::prefilter::RoughnessMapping;
-use splitsum_spirv as spirv;
 
 /// Where the bake runs.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]
@@ -267,13 +266,7 @@ impl Baker {
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("splitsum textures") });
         let dispatches: Vec<crate::backend::gpu::Dispatch> = params
             .iter()
-            .map(|p| crate::backend::gpu::Dispatch {
-                kernel: &spirv::KERNELS_PACK_HALF,
-                params: bytemuck::bytes_of(p),
-                input: Some(&texels.buffer),
-                output: &packed,
-                invocations: [p.width, p.rows, 1],
-            })
+            .map(|p| crate::backend::gpu::kernel::PACK_HALF.dispatch(p, Some(&texels.buffer), &packed, [p.width, p.rows, 1]))
             .collect();
         g.record(&mut encoder, &dispatches);
         for (m, p) in params.iter().enumerate() {
@@ -454,13 +447,7 @@ fn texture_source_cube(g: &Gpu, texture: &wgpu::Texture, job: &Job) -> Result<(T
     };
     let texels = Texels { buffer: g.output("source texels", count as u64 * 16)?, count };
     let p = RowsParams { width: size.width, rows, texel_offset: 0, row_words: row / 4, word_offset: 0, channels: 4, half: half as u32 };
-    g.run(&[crate::backend::gpu::Dispatch {
-        kernel: &spirv::KERNELS_UNPACK_ROWS,
-        params: bytemuck::bytes_of(&p),
-        input: Some(&words),
-        output: &texels.buffer,
-        invocations: [size.width, rows, 1],
-    }]);
+    g.run(&[crate::backend::gpu::kernel::UNPACK_ROWS.dispatch(&p, Some(&words), &texels.buffer, [size.width, rows, 1])]);
     match shape {
         Shape::Equirect => Ok((g.pyramid_to_cube(&texels.buffer, size.width, size.height, job.source_size, job.supersample, job.facing)?, job.source_layout())),
         Shape::Cube => cube_from_texture(g, texels, size.width, job),

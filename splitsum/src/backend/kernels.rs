@@ -55,6 +55,11 @@ pub trait Kernels {
     /// Where this backend keeps texels.
     type Texels;
 
+    /// The largest buffer the backend binds as one storage buffer, in bytes (`None`: no
+    /// limit, the CPU): what `crate::placement` places each step by.
+    fn max_binding(&self) -> Option<u64> {
+        None
+    }
     /// Waits until the work submitted so far has run (the GPU's queue; nothing on the CPU),
     /// so that a step's wall time is its own.
     fn finish(&self) -> Result<()>;

@@ -4,7 +4,7 @@
 use super::{group_layout, kernel_pipeline};
 use crate::error::{Error, Result};
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
-use splitsum_spirv::{self as spirv, Resource};
+use splitsum_spirv::Resource;
 use std::borrow::Cow;
 
 /// Whether `device` copies cube textures to buffers. wgpu's GL backend makes every square
@@ -27,7 +27,7 @@ impl CubeReader {
     /// The kernel's pipeline on `device` for textures of `format` (filterable or not, as
     /// `Rgba32Float` is not).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Self {
-        let k = &spirv::KERNELS_READ_CUBE;
+        let k = super::kernel::READ_CUBE.entry;
         let filterable = format.guaranteed_format_features(device.features()).flags.contains(wgpu::TextureFormatFeatureFlags::FILTERABLE);
         let entries: Vec<wgpu::BindGroupLayoutEntry> = group_layout(&[k], 0)
             .into_iter()
@@ -57,7 +57,7 @@ impl CubeReader {
     /// as `layout` (level by level, face by face), cleaned (`half::clean_radiance`).
     pub fn record(&self, device: &wgpu::Device, queue: &wgpu::Queue, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, layout: CubeLayout, out: &wgpu::Buffer) {
         use splitsum_shaders::kernels::ReadCubeParams;
-        let k = &spirv::KERNELS_READ_CUBE;
+        let k = super::kernel::READ_CUBE.entry;
         let view = texture.create_view(&wgpu::TextureViewDescriptor { dimension: Some(wgpu::TextureViewDimension::Cube), ..Default::default() });
         let groups: Vec<(wgpu::BindGroup, [u32; 3])> = (0..layout.levels)
             .map(|level| {

@@ -4,7 +4,7 @@
 //!
 //! Start-up (device and the pipelines of every kernel a bake runs) happens in [`Gpu::new`]
 //! or [`Gpu::on_device`], so that the time of a bake excludes it; the kernels only tools
-//! run ([`ON_DEMAND`]: the sampled table, the table's quadrature, calibration, probes) are
+//! run (`kernel::Kernel::on_demand`: the sampled table, the table's quadrature, calibration, probes) are
 //! built when first needed, each checked as at start-up. Each [`Gpu::run`] records its dispatches in one
 //! command encoder and submits them: a step's levels together, and each chunk of a long sum
 //! (at most `math::CHUNK` terms, under drivers' time limits per submission) on its own; the
@@ -17,6 +17,7 @@ use std::borrow::Cow;
 use std::collections::HashMap;
 
 mod buffers;
+pub mod kernel;
 mod steps;
 pub use buffers::{CubeReader, copies_cubes, filled, map_read, map_read_async};
 pub use steps::Texels;
@@ -43,27 +44,27 @@ pub struct Gpu {
 /// A kernel's pipeline and its bind group layout.
 type Pipeline = std::sync::Arc<(wgpu::ComputePipeline, wgpu::BindGroupLayout)>;
 
-/// The kernels a bake never runs, built on first use natively (`Gpu::ensure`): the
-/// sampled BRDF table and the resolve of its chunks, the table's quadrature (the defaults'
-/// table is embedded, others are computed once per process), the calibration of the cost
-/// model and the probes of reports and tests. (In a browser, where nothing may block on
-/// the error scope that checks a pipeline, every pipeline is built at start-up.)
-pub const ON_DEMAND: [&EntryPoint; 5] = [&spirv::KERNELS_BRDF_LUT, &spirv::KERNELS_RESOLVE_LUT, &spirv::KERNELS_BRDF_TABLE, &spirv::KERNELS_CALIBRATE, &spirv::KERNELS_PROBE];
+/// Whether the pipeline of `k` is built at start-up: not the cube reader's (it binds a
+/// texture of the caller's format: `CubeReader`), and natively not those of the kernels a
+/// bake never runs (`kernel::Kernel::on_demand`: the sampled BRDF table and the resolve of
+/// its chunks, the table's quadrature (the defaults' table is embedded, others are computed
+/// once per process), the calibration of the cost model and the probes of reports and
+/// tests), built on first use (`Gpu::ensure`). In a browser, where nothing may block on
+/// the error scope that checks a pipeline, every other pipeline is built at start-up.
+fn at_start_up(k: &EntryPoint, on_demand: bool) -> bool {
+    k.name != kernel::READ_CUBE.entry.name && !(cfg!(not(target_arch = "wasm32")) && on_demand)
+}
 
 /// One dispatch: a kernel, its parameter block, an optional input and the output buffer,
 /// bound where the kernel's generated linkage says (its uniform, its read-only storage
-/// buffer and its written one).
+/// buffer and its written one). Made only by [`kernel::Kernel::dispatch`], which takes the
+/// kernel's own parameter block.
 pub struct Dispatch<'a> {
-    /// The kernel's entry point (a `splitsum_spirv::KERNELS_*` constant).
-    pub kernel: &'static EntryPoint,
-    /// The uniform parameter block (a `Pod` struct of `kernels`).
-    pub params: &'a [u8],
-    /// The read-only input, if the kernel reads one.
-    pub input: Option<&'a wgpu::Buffer>,
-    /// The output.
-    pub output: &'a wgpu::Buffer,
-    /// Invocations along x, y, z; rounded up to whole workgroups of the kernel's size.
-    pub invocations: [u32; 3],
+    kernel: &'static EntryPoint,
+    params: &'a [u8],
+    input: Option<&'a wgpu::Buffer>,
+    output: &'a wgpu::Buffer,
+    invocations: [u32; 3],
 }
 
 /// The bind-group-layout entry of `b`, visible to `visibility`.
@@ -253,10 +254,8 @@ impl Gpu {
             return Err(Error::gpu_caused(format!("the shader module did not validate on {}", info.name), e.to_string()));
         }
         // Each pipeline checked in an error scope of its own, so that an error names its
-        // kernel. The cube reader binds a texture of the caller's format: built when needed;
-        // natively, so are the kernels of tools alone (`ON_DEMAND`).
-        let later = |k: &&EntryPoint| k.name == spirv::KERNELS_READ_CUBE.name || (cfg!(not(target_arch = "wasm32")) && ON_DEMAND.iter().any(|o| o.name == k.name));
-        let kernels: Vec<&EntryPoint> = splitsum_spirv::KERNELS.iter().filter(|k| !later(k)).collect();
+        // kernel; those built on demand are not built here (`at_start_up`).
+        let kernels: Vec<&EntryPoint> = kernel::ALL.iter().filter(|(k, on_demand)| at_start_up(k, *on_demand)).map(|(k, _)| *k).collect();
         let build = |k: &EntryPoint| {
             let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
@@ -302,10 +301,11 @@ impl Gpu {
         Ok(Self { instance: None, adapter: None, module, device: device.clone(), queue: queue.clone(), info, pipelines: std::sync::RwLock::new(pipelines), empty })
     }
 
-    /// Builds the pipeline of kernel `k` if it is not built yet (the kernels of
-    /// [`ON_DEMAND`]), checked in an error scope of its own as at start-up.
+    /// Builds the pipeline of kernel `k` if it is not built yet (a kernel built on
+    /// demand), checked in an error scope of its own as at start-up.
     #[cfg(not(target_arch = "wasm32"))]
-    pub(crate) fn ensure(&self, k: &'static EntryPoint) -> Result<()> {
+    pub(crate) fn ensure<P>(&self, k: &kernel::Kernel<P>) -> Result<()> {
+        let k = k.entry;
         if self.pipelines.read().unwrap_or_else(|e| e.into_inner()).contains_key(k.name) {
             return Ok(());
         }
@@ -321,7 +321,7 @@ impl Gpu {
 
     /// In a browser every pipeline is built at start-up.
     #[cfg(target_arch = "wasm32")]
-    pub(crate) fn ensure(&self, _k: &'static EntryPoint) -> Result<()> {
+    pub(crate) fn ensure<P>(&self, _k: &kernel::Kernel<P>) -> Result<()> {
         Ok(())
     }
 

@@ -2,8 +2,8 @@
 //! generated linkage, its chunked sums resolved on the device, its buffers checked against
 //! the device's binding limit before anything is allocated.
 
+use super::kernel::{self, Kernel};
 use super::{Dispatch, Gpu};
-use crate::backend::cpu::Cpu;
 use crate::backend::kernels::{Kernels, Prefilter, chunks};
 use crate::error::{Error, Result};
 use crate::texture::{Equirect, Sh9};
@@ -16,7 +16,6 @@ use splitsum_shaders::irradiance::SH9;
 use splitsum_shaders::calibrate::Rate;
 use splitsum_shaders::kernels::{CalibrateParams, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, ResolveParams, TableParams};
 use splitsum_shaders::{equirect, lut, prefilter};
-use splitsum_spirv::{self as spirv, EntryPoint};
 
 /// Texels on the device: `count` RGBA f32 texels in `buffer`.
 pub struct Texels {
@@ -32,22 +31,19 @@ fn bytes(texels: u64) -> u64 {
 }
 
 impl Gpu {
-    /// Whether each of `buffers` (bytes) fits in one storage binding of the device;
-    /// otherwise a note on stderr that `step` runs on the CPU instead (the same shared
-    /// functions, so the results agree within the GPU-vs-CPU bounds).
-    fn fits(&self, step: &str, buffers: &[u64]) -> bool {
-        let max = self.max_binding();
-        match buffers.iter().copied().max() {
-            Some(need) if need > max => {
-                crate::progress::note(&format!(
-                    "note: {step} needs a {:.0} MiB buffer, more than {} binds ({:.0} MiB): running this step on the CPU",
-                    need as f64 / 1048576.0,
-                    self.info.name,
-                    max as f64 / 1048576.0
-                ));
-                false
-            }
-            _ => true,
+    /// Refuses a step whose largest buffer is more than one storage binding of the device
+    /// holds: the bake sequence places such a step on the CPU beforehand
+    /// (`crate::placement`), and so do the host-data conveniences (`crate::host`).
+    fn binds(&self, step: &str, buffers: &[u64]) -> Result<()> {
+        let needs = buffers.iter().copied().max().unwrap_or(0);
+        match crate::placement::place_buffer(needs, Some(self.max_binding())) {
+            crate::placement::Place::Device => Ok(()),
+            crate::placement::Place::Host { needs, binds } => Err(Error::gpu(format!(
+                "{step} needs a {:.0} MiB buffer, more than {} binds ({:.0} MiB): place it on the CPU (splitsum::placement)",
+                needs as f64 / 1048576.0,
+                self.info.name,
+                binds as f64 / 1048576.0
+            ))),
         }
     }
 
@@ -59,15 +55,15 @@ impl Gpu {
     /// Runs a table kernel over the rows of a `size`×`size` table, `per_texel` integrand
     /// evaluations a texel, with the parameters `params(first row)`: about 2²⁶ evaluations
     /// per submission, so that none runs long enough to trip a display driver's watchdog.
-    fn table_rows<P: bytemuck::Pod>(&self, kernel: &'static EntryPoint, size: u32, per_texel: u32, output: &wgpu::Buffer, params: impl Fn(u32) -> P) {
+    fn table_rows<P: bytemuck::Pod>(&self, kernel: &Kernel<P>, size: u32, per_texel: u32, output: &wgpu::Buffer, params: impl Fn(u32) -> P) {
         let rows = ((1u64 << 26) / (size as u64 * per_texel.max(1) as u64)).clamp(1, size as u64) as u32;
-        let tile = kernel.workgroup_size[1];
+        let tile = kernel.entry.workgroup_size[1];
         let rows = rows.div_ceil(tile) * tile;
         let mut row = 0;
         while row < size {
             let p = params(row);
             let h = rows.min(size - row);
-            self.run(&[Dispatch { kernel, params: bytemuck::bytes_of(&p), input: None, output, invocations: [size, h, 1] }]);
+            self.run(&[kernel.dispatch(&p, None, output, [size, h, 1])]);
             row += h;
         }
     }
@@ -76,13 +72,7 @@ impl Gpu {
     /// `offset` on, written at the same index of `out`.
     fn resolve(&self, accum: &wgpu::Buffer, out: &wgpu::Buffer, offset: u32, count: u32) {
         let p = ResolveParams { count, src_offset: offset, dst_offset: offset, samples: 0 };
-        self.run(&[Dispatch {
-            kernel: &spirv::KERNELS_RESOLVE_MEANS,
-            params: bytemuck::bytes_of(&p),
-            input: Some(accum),
-            output: out,
-            invocations: [count, 1, 1],
-        }]);
+        self.run(&[kernel::RESOLVE_MEANS.dispatch(&p, Some(accum), out, [count, 1, 1])]);
     }
 
     internal! {
@@ -96,23 +86,11 @@ impl Gpu {
             let params: Vec<EquirectParams> = (1..levels).map(|level| EquirectParams { level, ..base }).collect();
             let dispatches: Vec<Dispatch> = params
                 .iter()
-                .map(|p| Dispatch {
-                    kernel: &spirv::KERNELS_EQUIRECT_PYRAMID,
-                    params: bytemuck::bytes_of(p),
-                    input: None,
-                    output: pyramid,
-                    invocations: [w >> p.level, h, 1],
-                })
+                .map(|p| kernel::EQUIRECT_PYRAMID.dispatch(p, None, pyramid, [w >> p.level, h, 1]))
                 .collect();
             self.run(&dispatches);
             let out = self.texels("source cube", layout.texel_count())?;
-            self.run(&[Dispatch {
-                kernel: &spirv::KERNELS_EQUIRECT_TO_CUBE,
-                params: bytemuck::bytes_of(&base),
-                input: Some(pyramid),
-                output: &out.buffer,
-                invocations: [size, size, FACES],
-            }]);
+            self.run(&[kernel::EQUIRECT_TO_CUBE.dispatch(&base, Some(pyramid), &out.buffer, [size, size, FACES])]);
             self.mips(&out.buffer, layout);
             Ok(out)
         }
@@ -125,7 +103,7 @@ impl Gpu {
             .iter()
             .map(|p| {
                 let s = layout.level_size(p.level + 1);
-                Dispatch { kernel: &spirv::KERNELS_DOWNSAMPLE, params: bytemuck::bytes_of(p), input: None, output: cube, invocations: [s, s, FACES] }
+                kernel::DOWNSAMPLE.dispatch(p, None, cube, [s, s, FACES])
             })
             .collect();
         self.run(&dispatches);
@@ -144,6 +122,10 @@ impl Gpu {
 
 impl Kernels for Gpu {
     type Texels = Texels;
+
+    fn max_binding(&self) -> Option<u64> {
+        Some(Gpu::max_binding(self))
+    }
 
     fn finish(&self) -> Result<()> {
         self.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::gpu_caused("waiting for the device", e))?;
@@ -170,9 +152,7 @@ impl Kernels for Gpu {
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
         let (w, h) = (env.width, env.height);
         let pyramid_bytes = bytes(equirect::pyramid_len(w, h) as u64);
-        if !self.fits(&format!("resampling the {w}×{h} equirect (its row pyramid)"), &[pyramid_bytes, bytes(layout.texel_count() as u64)]) {
-            return self.upload("source cube", &Cpu.equirect_to_cube(env, size, supersample, facing)?);
-        }
+        self.binds(&format!("resampling the {w}×{h} equirect (its row pyramid)"), &[pyramid_bytes, bytes(layout.texel_count() as u64)])?;
         let mut texels = env.texels.clone();
         texels.resize(equirect::pyramid_len(w, h) as usize, Vec4::ZERO);
         let pyramid = self.upload_bytes("equirect pyramid", bytemuck::cast_slice(&texels));
@@ -180,13 +160,7 @@ impl Kernels for Gpu {
     }
 
     fn build_mips(&self, cube: &mut Texels, layout: CubeLayout) -> Result<()> {
-        let s = layout.size;
-        if !self.fits(&format!("the mips of the {s}² cube"), &[bytes(cube.count as u64)]) {
-            let mut host = self.read_texels(cube)?;
-            Cpu.build_mips(&mut host, layout)?;
-            *cube = self.upload("cube", &host)?;
-            return Ok(());
-        }
+        self.binds(&format!("the mips of the {}² cube", layout.size), &[bytes(cube.count as u64)])?;
         self.mips(&cube.buffer, layout);
         Ok(())
     }
@@ -194,9 +168,7 @@ impl Kernels for Gpu {
     fn prefilter(&self, src: &Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Texels> {
         let out = job.layout;
         let buffers = [bytes(src.count as u64), 3 * bytes(out.texel_count() as u64)];
-        if !self.fits(&format!("the {} cube from the {}² source cube", job.what(), src_layout.size), &buffers) {
-            return self.upload(job.what(), &Cpu.prefilter(&self.read_texels(src)?, src_layout, job)?);
-        }
+        self.binds(&format!("the {} cube from the {}² source cube", job.what(), src_layout.size), &buffers)?;
         let accum = self.output("prefilter sums", 3 * bytes(out.texel_count() as u64))?;
         let result = self.texels(job.what(), out.texel_count())?;
         for &m in job.levels {
@@ -217,30 +189,18 @@ impl Kernels for Gpu {
             };
             if job.lobe.is_mirror(r) {
                 // A mirror: the source read along each texel's direction, no sum.
-                self.run(&[Dispatch {
-                    kernel: &spirv::KERNELS_PREFILTER_MIRROR,
-                    params: bytemuck::bytes_of(&p),
-                    input: Some(&src.buffer),
-                    output: &result.buffer,
-                    invocations: [s, s, FACES],
-                }]);
+                self.run(&[kernel::PREFILTER_MIRROR.dispatch(&p, Some(&src.buffer), &result.buffer, [s, s, FACES])]);
                 continue;
             }
             // An exact sum runs over every texel of its source level, in chunks.
             let (terms, kernel) = if exact_level == prefilter::SAMPLED {
-                (samples, &spirv::KERNELS_PREFILTER_SPECULAR)
+                (samples, &kernel::PREFILTER_SAMPLED)
             } else {
-                (FACES * src_layout.level_size(exact_level).pow(2), &spirv::KERNELS_PREFILTER_EXACT)
+                (FACES * src_layout.level_size(exact_level).pow(2), &kernel::PREFILTER_EXACT)
             };
             for (start, count) in chunks(terms) {
                 let p = PrefilterParams { start, count, ..p };
-                self.run(&[Dispatch {
-                    kernel,
-                    params: bytemuck::bytes_of(&p),
-                    input: Some(&src.buffer),
-                    output: &accum,
-                    invocations: [s, s, FACES],
-                }]);
+                self.run(&[kernel.dispatch(&p, Some(&src.buffer), &accum, [s, s, FACES])]);
             }
             self.resolve(&accum, &result.buffer, out.level_offset(m), FACES * s * s);
         }
@@ -250,9 +210,7 @@ impl Kernels for Gpu {
     fn irradiance(&self, src: &Texels, src_layout: CubeLayout, level: u32, size: u32) -> Result<Texels> {
         let layout = CubeLayout::new(size, 1);
         let buffers = [bytes(src.count as u64), 3 * bytes(layout.texel_count() as u64)];
-        if !self.fits(&format!("the irradiance from the {}² source cube", src_layout.size), &buffers) {
-            return self.upload("irradiance", &Cpu.irradiance(&self.read_texels(src)?, src_layout, level, size)?);
-        }
+        self.binds(&format!("the irradiance from the {}² source cube", src_layout.size), &buffers)?;
         let accum = self.output("irradiance sums", 3 * bytes(layout.texel_count() as u64))?;
         let s = src_layout.level_size(level);
         // The summed level alone, as a one-level cube, followed by its geometry table.
@@ -265,13 +223,7 @@ impl Kernels for Gpu {
         self.queue.write_buffer(&input, bytes(n as u64), bytemuck::cast_slice(&geometry));
         for (start, count) in chunks(n) {
             let p = IrradianceParams { src_size: s, src_levels: 1, src_level: 0, dst_size: size, start, count, geometry: n };
-            self.run(&[Dispatch {
-                kernel: &spirv::KERNELS_IRRADIANCE_CUBE,
-                params: bytemuck::bytes_of(&p),
-                input: Some(&input),
-                output: &accum,
-                invocations: [size, size, FACES],
-            }]);
+            self.run(&[kernel::IRRADIANCE_CUBE.dispatch(&p, Some(&input), &accum, [size, size, FACES])]);
         }
         let result = self.texels("irradiance", layout.texel_count())?;
         self.resolve(&accum, &result.buffer, 0, layout.texel_count());
@@ -279,85 +231,59 @@ impl Kernels for Gpu {
     }
 
     fn sh9(&self, src: &Texels, src_layout: CubeLayout, level: u32) -> Result<Sh9> {
-        if !self.fits(&format!("SH9 from the {}² source cube", src_layout.size), &[bytes(src.count as u64)]) {
-            return Cpu.sh9(&self.read_texels(src)?, src_layout, level);
-        }
+        self.binds(&format!("SH9 from the {}² source cube", src_layout.size), &[bytes(src.count as u64)])?;
         let s = src_layout.level_size(level);
         let n = FACES * s * (SH9 as u32 + 1);
         let dst = self.texels("sh9 rows", n)?;
         let p = IrradianceParams { src_size: src_layout.size, src_levels: src_layout.levels, src_level: level, dst_size: 0, start: 0, count: 0, geometry: cubemap::INLINE_GEOMETRY };
-        self.run(&[Dispatch {
-            kernel: &spirv::KERNELS_IRRADIANCE_SH9_PROJECT,
-            params: bytemuck::bytes_of(&p),
-            input: Some(&src.buffer),
-            output: &dst.buffer,
-            invocations: [s, 1, FACES],
-        }]);
+        self.run(&[kernel::IRRADIANCE_SH9_PROJECT.dispatch(&p, Some(&src.buffer), &dst.buffer, [s, 1, FACES])]);
         let rows: Vec<[Vec4; SH9 + 1]> = self.read_texels(&dst)?.chunks_exact(SH9 + 1).map(|c| c.try_into().expect("10 per row")).collect();
         Ok(Sh9::from_rows(&rows))
     }
 
     fn brdf_lut(&self, size: u32, samples: u32) -> Result<Texels> {
         let n = size * size;
-        if !self.fits("the BRDF table", &[bytes(n as u64)]) {
-            return self.upload("brdf lut", &Cpu.brdf_lut(size, samples)?);
-        }
-        self.ensure(&spirv::KERNELS_BRDF_LUT)?;
-        self.ensure(&spirv::KERNELS_RESOLVE_LUT)?;
+        self.binds("the BRDF table", &[bytes(n as u64)])?;
+        self.ensure(&kernel::BRDF_LUT)?;
+        self.ensure(&kernel::RESOLVE_LUT)?;
         let accum = self.output("brdf lut sums", bytes(n as u64))?;
         for (start, count) in chunks(samples) {
-            self.table_rows(&spirv::KERNELS_BRDF_LUT, size, count, &accum, |row_offset| LutParams { size, samples, row_offset, start, count });
+            self.table_rows(&kernel::BRDF_LUT, size, count, &accum, |row_offset| LutParams { size, samples, row_offset, start, count });
         }
         let out = self.texels("brdf lut", n)?;
         let p = ResolveParams { count: n, src_offset: 0, dst_offset: 0, samples };
-        self.run(&[Dispatch {
-            kernel: &spirv::KERNELS_RESOLVE_LUT,
-            params: bytemuck::bytes_of(&p),
-            input: Some(&accum),
-            output: &out.buffer,
-            invocations: [n, 1, 1],
-        }]);
+        self.run(&[kernel::RESOLVE_LUT.dispatch(&p, Some(&accum), &out.buffer, [n, 1, 1])]);
         Ok(out)
     }
 
     fn brdf_table(&self, size: u32, masking: Masking) -> Result<Texels> {
         let n = size * size;
-        if !self.fits("the BRDF table", &[bytes(n as u64)]) {
-            return self.upload("brdf table", &Cpu.brdf_table(size, masking)?);
-        }
-        self.ensure(&spirv::KERNELS_BRDF_TABLE)?;
+        self.binds("the BRDF table", &[bytes(n as u64)])?;
+        self.ensure(&kernel::BRDF_TABLE)?;
         let out = self.texels("brdf table", n)?;
         let per_texel = lut::QUADRATURE_MEAN_EVALUATIONS;
-        self.table_rows(&spirv::KERNELS_BRDF_TABLE, size, per_texel, &out.buffer, |row_offset| TableParams { size, masking: masking as u32, row_offset });
+        self.table_rows(&kernel::BRDF_TABLE, size, per_texel, &out.buffer, |row_offset| TableParams { size, masking: masking as u32, row_offset });
         Ok(out)
     }
 
     fn calibrate(&self, src: &Texels, src_layout: CubeLayout, rate: Rate, size: u32, count: u32) -> Result<Texels> {
-        self.ensure(&spirv::KERNELS_CALIBRATE)?;
+        self.ensure(&kernel::CALIBRATE)?;
         let out = self.texels("calibration", FACES * size * size)?;
         let p = CalibrateParams { rate: rate as u32, size, src_size: src_layout.size, src_levels: src_layout.levels, count };
-        self.run(&[Dispatch { kernel: &spirv::KERNELS_CALIBRATE, params: bytemuck::bytes_of(&p), input: Some(&src.buffer), output: &out.buffer, invocations: [size, size, FACES] }]);
+        self.run(&[kernel::CALIBRATE.dispatch(&p, Some(&src.buffer), &out.buffer, [size, size, FACES])]);
         Ok(out)
     }
 
     fn probe_raw(&self, p: ProbeParams, texels: &[Vec4], probes: &[Vec4], terms: u32) -> Result<Vec<Vec4>> {
-        if !self.fits("the probes", &[bytes((texels.len() + probes.len()) as u64), 3 * bytes(probes.len() as u64)]) {
-            return Cpu.probe_raw(p, texels, probes, terms);
-        }
-        self.ensure(&spirv::KERNELS_PROBE)?;
+        self.binds("the probes", &[bytes((texels.len() + probes.len()) as u64), 3 * bytes(probes.len() as u64)])?;
+        self.ensure(&kernel::PROBE)?;
         let mut input = texels.to_vec();
         input.extend_from_slice(probes);
         let buf = self.upload_bytes("probes", bytemuck::cast_slice(&input));
         let out = self.texels("probe results", 3 * p.count)?;
         for (start, chunk) in chunks(terms) {
             let pc = ProbeParams { start, chunk, ..p };
-            self.run(&[Dispatch {
-                kernel: &spirv::KERNELS_PROBE,
-                params: bytemuck::bytes_of(&pc),
-                input: Some(&buf),
-                output: &out.buffer,
-                invocations: [p.count, 1, 1],
-            }]);
+            self.run(&[kernel::PROBE.dispatch(&pc, Some(&buf), &out.buffer, [p.count, 1, 1])]);
         }
         self.read_texels(&out)
     }
