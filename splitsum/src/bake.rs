@@ -224,7 +224,8 @@ fn make_product<K: Kernels>(k: &K, p: Product, source: &K::Texels, source_layout
         // Constants (`crate::table`): embedded or computed once per process, then uploaded.
         Product::BrdfTable => Item::Table(k.upload("brdf table", &crate::table::texels(crate::table::TableKey::of(job))?)?),
         Product::SheenTables => Item::Table(k.upload("sheen tables", &crate::table::sheen_texels())?),
-        Product::SourceCube | Product::Specular | Product::Sheen => unreachable!("the source cube is made first, by source_cube"),
+        Product::SourceCube => unreachable!("the source cube is made first, by source_cube"),
+        _ => unreachable!("{p} is a prefiltered cube, made above"),
     })
 }
 
@@ -232,6 +233,7 @@ fn make_product<K: Kernels>(k: &K, p: Product, source: &K::Texels, source_layout
 pub fn prefilter(job: &Job, p: Product) -> Prefilter<'_> {
     let cube = &job.prefiltered[&p];
     Prefilter {
+        what: p.name(),
         lobe: p.lobe().expect("a prefiltered cube has a lobe"),
         layout: job.specular_layout(),
         roughness: &cube.roughness_per_mip,
@@ -250,7 +252,11 @@ pub fn make<K: Kernels>(k: &K, est: &mut Estimator, env: &Environment, job: &Job
     let (source, layout) = timed(k, &mut timings, Product::SourceCube, job, est, || match place {
         Place::Device => source_cube(k, env, job),
         Place::Host { .. } => {
-            placement::note("the source cube", place, "the device");
+            let what = match env {
+                Environment::Equirect(e) => format!("resampling the {}×{} equirect (its row pyramid)", e.width, e.height),
+                Environment::Cube(c) => format!("the mips of the {}² cube", c.layout.size),
+            };
+            placement::note(&what, place, "the device");
             let (t, layout) = source_cube(&Cpu, env, job)?;
             Ok((k.upload("source cube", &t)?, layout))
         }

@@ -270,7 +270,7 @@ pub fn work(p: Product, job: &Job) -> Work {
             w.bytes += 16.0 * texels;
         }
         Product::SheenTables => w.bytes += 16.0 * (crate::table::SHEEN_TABLE_SIZE as f64).powi(2),
-        Product::Specular | Product::Sheen => unreachable!("a prefiltered cube"),
+        _ => unreachable!("{p} is a prefiltered cube, matched above"),
     }
     w
 }
@@ -290,7 +290,7 @@ pub fn bytes(p: Product, job: &Job) -> u64 {
         Product::Sh9 => 0,
         Product::BrdfTable => (job.lut_size as u64).pow(2) * 24,
         Product::SheenTables => (crate::table::SHEEN_TABLE_SIZE as u64).pow(2) * 24,
-        Product::Specular | Product::Sheen => unreachable!("a prefiltered cube"),
+        _ => unreachable!("{p} is a prefiltered cube, matched above"),
     }
 }
 

@@ -114,7 +114,7 @@ impl Backend {
                 return Err(Error::setting(Field::Samples, "must be at least 1, not 0"));
             }
             let exact = crate::settings::exact_levels(lobe, roughness, samples, exact, src.layout);
-            let job = Prefilter { lobe, layout: out, roughness, levels, samples, exact: &exact, lod_bias };
+            let job = Prefilter { what: "prefiltered", lobe, layout: out, roughness, levels, samples, exact: &exact, lod_bias };
             let needs = texel_bytes(src.texels.len() as u64).max(3 * texel_bytes(out.texel_count() as u64));
             self.placed("the prefiltered cube", needs, |b| {
                 with_kernels!(b, k => {

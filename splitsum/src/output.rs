@@ -216,7 +216,8 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
         files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
     };
     let mut jobs: Vec<FileJob<'a>> = Vec::new();
-    if let (Some(cube), Some(_)) = (baked.cube(p), p.lobe()) {
+    if p.lobe().is_some() {
+        let Some(cube) = baked.cube(p) else { return jobs };
         let key = p.key();
         let mapping = job.prefiltered[&p].mapping;
         jobs.push(Box::new(move || {
@@ -299,7 +300,7 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
                 )])
             }));
         }
-        Product::Specular | Product::Sheen => {}
+        _ => unreachable!("{p} is a prefiltered cube, written above"),
     }
     jobs
 }

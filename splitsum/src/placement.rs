@@ -45,7 +45,7 @@ pub fn largest_buffer(p: Product, job: &Job) -> u64 {
         Product::Sh9 => source,
         Product::BrdfTable => texel_bytes((job.lut_size as u64).pow(2)),
         Product::SheenTables => texel_bytes((crate::product::SHEEN_TABLE_SIZE as u64).pow(2)),
-        Product::Specular | Product::Sheen => unreachable!("a prefiltered cube"),
+        _ => unreachable!("{p} is a prefiltered cube, matched above"),
     }
 }
 

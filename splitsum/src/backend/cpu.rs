@@ -125,7 +125,7 @@ impl Kernels for Cpu {
         let out = job.layout;
         let mut texels = vec![Vec4::ZERO; out.texel_count() as usize];
         let rows: u64 = job.levels.iter().map(|&m| (FACES * out.level_size(m)) as u64).sum();
-        let bar = progress(job.what(), rows);
+        let bar = progress(job.what, rows);
         for &m in job.levels {
             let s = out.level_size(m);
             let start = out.level_offset(m) as usize;

@@ -23,6 +23,8 @@ pub fn chunks(n: u32) -> impl Iterator<Item = (u32, u32)> {
 /// what nothing reads).
 #[derive(Clone, Debug)]
 pub struct Prefilter<'a> {
+    /// What the cube is, for progress and labels: the product's name (`specular`, `sheen`).
+    pub what: &'static str,
     /// The distribution.
     pub lobe: Lobe,
     /// Layout of the cube.
@@ -37,16 +39,6 @@ pub struct Prefilter<'a> {
     pub exact: &'a [u32],
     /// Added to the source level of each sample.
     pub lod_bias: f32,
-}
-
-impl Prefilter<'_> {
-    /// What the cube is, for progress and labels: `specular` or `sheen`.
-    pub fn what(&self) -> &'static str {
-        match self.lobe {
-            Lobe::Ggx => "specular",
-            Lobe::Charlie => "sheen",
-        }
-    }
 }
 
 /// The operations a bake is made of, on one backend. Cubes are texels in `CubeLayout`

@@ -160,7 +160,7 @@ impl Job {
                 Product::BrdfTable => Layout::Table(self.lut_size),
                 Product::SheenTables => Layout::Table(crate::product::SHEEN_TABLE_SIZE),
                 Product::Sh9 => Layout::Coefficients,
-                Product::Specular | Product::Sheen => unreachable!("a prefiltered cube"),
+                _ => unreachable!("{p} is a prefiltered cube, matched above"),
             }
         }
     }

@@ -1,6 +1,6 @@
 //! Typed kernel handles: each compute entry point of the generated linkage
 //! (`splitsum_spirv::KERNELS`) with the parameter block its shader reads
-//! (`splitsum_shaders::kernels`), declared once in [`kernels!`]. A dispatch is made only
+//! (`splitsum_shaders::kernels`), declared once in `kernels!`. A dispatch is made only
 //! through [`Kernel::dispatch`], which takes that block by type: a kernel cannot be handed
 //! another kernel's parameters, and the host never spells an entry name, a binding or a
 //! workgroup size. Whether a pipeline is built at start-up or on first use is declared here

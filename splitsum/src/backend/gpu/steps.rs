@@ -168,9 +168,9 @@ impl Kernels for Gpu {
     fn prefilter(&self, src: &Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Texels> {
         let out = job.layout;
         let buffers = [bytes(src.count as u64), 3 * bytes(out.texel_count() as u64)];
-        self.binds(&format!("the {} cube from the {}² source cube", job.what(), src_layout.size), &buffers)?;
+        self.binds(&format!("the {} cube from the {}² source cube", job.what, src_layout.size), &buffers)?;
         let accum = self.output("prefilter sums", 3 * bytes(out.texel_count() as u64))?;
-        let result = self.texels(job.what(), out.texel_count())?;
+        let result = self.texels(job.what, out.texel_count())?;
         for &m in job.levels {
             let (r, samples, exact_level) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
             let s = out.level_size(m);
