@@ -317,3 +317,39 @@ impl Serialize for Products {
         s.collect_seq(self.iter().map(Product::key))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A set always holds the source cube; the sheen cube comes with its tables, in and
+    /// out; a set lists its products in the order a bake makes them, and serialises as
+    /// their keys.
+    #[test]
+    fn a_set_of_products_keeps_what_comes_together() {
+        assert_eq!(Products::SOURCE.iter().collect::<Vec<_>>(), vec![Product::SourceCube]);
+        let sheen = Products::DISPLAY.with(Product::Sheen, true);
+        assert!(sheen.has(Product::SheenTables), "the sheen cube comes with its tables");
+        assert_eq!(sheen.without(Product::Sheen), Products::DISPLAY);
+        assert_eq!(Products::DISPLAY.without(Product::SourceCube), Products::DISPLAY, "never without the source cube");
+        assert_eq!(Products::DISPLAY.with(Product::Sh9, false), Products::DISPLAY);
+        assert_eq!(Products::ALL.iter().collect::<Vec<_>>(), Product::ALL.to_vec());
+        assert_eq!(serde_json::to_string(&Products::of(&[Product::BrdfTable])).unwrap(), r#"["source_cube","brdf_table"]"#);
+    }
+
+    /// Each product's place in `Product::ALL` is its index; its key is what serde writes;
+    /// its cache file and key are its own; exactly the specular and sheen cubes have a lobe.
+    #[test]
+    fn the_table_is_consistent() {
+        for (k, p) in Product::ALL.into_iter().enumerate() {
+            assert_eq!(p.index(), k);
+            assert_eq!(serde_json::to_string(&p).unwrap(), format!("\"{}\"", p.key()));
+            assert_eq!(p.lobe().is_some(), matches!(p, Product::Specular | Product::Sheen), "{p}");
+            assert_eq!(p.lobe().is_some(), p.shape() == Shape::Cube && p != Product::SourceCube && p != Product::Irradiance, "{p}");
+        }
+        let mut files: Vec<_> = Product::ALL.iter().map(|p| p.cache_file()).collect();
+        files.sort_unstable();
+        files.dedup();
+        assert_eq!(files.len(), Product::COUNT, "one cache file per product");
+    }
+}
