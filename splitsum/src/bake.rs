@@ -170,14 +170,13 @@ pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, job: &Job)
     }
     let full_layout = CubeLayout::new(face, CubeLayout::full_chain(face));
     let place = placement::place_buffer(placement::texel_bytes(full_layout.texel_count() as u64), k.max_binding());
-    match place {
-        Place::Device => k.build_mips(&mut full, full_layout)?,
-        Place::Host { .. } => {
-            placement::note(&format!("the mips of the {face}² cube"), place, "the device");
-            let mut host = k.read(&full)?;
-            Cpu.build_mips(&mut host, full_layout)?;
-            full = k.upload("cube", &host)?;
-        }
+    if let Place::Host { .. } = place {
+        placement::note(&format!("the mips of the {face}² cube"), place);
+        let mut host = k.read(&full)?;
+        Cpu.build_mips(&mut host, full_layout)?;
+        full = k.upload("cube", &host)?;
+    } else {
+        k.build_mips(&mut full, full_layout)?;
     }
     let start = full_layout.level_offset(crate::settings::level_of_size(full_layout, size));
     Ok((k.slice(&full, start, full_layout.texel_count() - start)?, job.source_layout()))
@@ -193,20 +192,23 @@ pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout,
     let mut host_source: Option<Vec<splitsum_shaders::glam::Vec4>> = None;
     for p in job.products.iter().filter(|p| *p != Product::SourceCube) {
         let place = placement::place(p, job, k.max_binding());
-        let item = timed(k, &mut made.timings, p, job, est, || match place {
-            Place::Device => make_product(k, p, &source, source_layout, job),
-            Place::Host { .. } => {
-                placement::note(&format!("the {p} step"), place, "the device");
-                let host = match &mut host_source {
-                    Some(h) => h,
-                    None => host_source.insert(k.read(&source)?),
-                };
-                Ok(match make_product(&Cpu, p, host, source_layout, job)? {
-                    Item::Cube(t) => Item::Cube(k.upload(p.name(), &t)?),
-                    Item::Table(t) => Item::Table(k.upload(p.name(), &t)?),
-                    Item::Coefficients(c) => Item::Coefficients(c),
-                })
-            }
+        let item = timed(k, &mut made.timings, p, job, est, || {
+            placement::run(
+                place,
+                || format!("the {p} step"),
+                || make_product(k, p, &source, source_layout, job),
+                || {
+                    let host = match &mut host_source {
+                        Some(h) => h,
+                        None => host_source.insert(k.read(&source)?),
+                    };
+                    Ok(match make_product(&Cpu, p, host, source_layout, job)? {
+                        Item::Cube(t) => Item::Cube(k.upload(p.name(), &t)?),
+                        Item::Table(t) => Item::Table(k.upload(p.name(), &t)?),
+                        Item::Coefficients(c) => Item::Coefficients(c),
+                    })
+                },
+            )
         })?;
         made.insert(p, item);
     }
@@ -249,17 +251,20 @@ pub fn prefilter(job: &Job, p: Product) -> Prefilter<'_> {
 pub fn make<K: Kernels>(k: &K, est: &mut Estimator, env: &Environment, job: &Job) -> Result<Made<K::Texels>> {
     let mut timings = Vec::new();
     let place = placement::place(Product::SourceCube, job, k.max_binding());
-    let (source, layout) = timed(k, &mut timings, Product::SourceCube, job, est, || match place {
-        Place::Device => source_cube(k, env, job),
-        Place::Host { .. } => {
-            let what = match env {
-                Environment::Equirect(e) => format!("resampling the {}×{} equirect (its row pyramid)", e.width, e.height),
-                Environment::Cube(c) => format!("the mips of the {}² cube", c.layout.size),
-            };
-            placement::note(&what, place, "the device");
-            let (t, layout) = source_cube(&Cpu, env, job)?;
-            Ok((k.upload("source cube", &t)?, layout))
-        }
+    let what = || match env {
+        Environment::Equirect(e) => format!("resampling the {}×{} equirect (its row pyramid)", e.width, e.height),
+        Environment::Cube(c) => format!("the mips of the {}² cube", c.layout.size),
+    };
+    let (source, layout) = timed(k, &mut timings, Product::SourceCube, job, est, || {
+        placement::run(
+            place,
+            what,
+            || source_cube(k, env, job),
+            || {
+                let (t, layout) = source_cube(&Cpu, env, job)?;
+                Ok((k.upload("source cube", &t)?, layout))
+            },
+        )
     })?;
     self::products(k, source, layout, job, est, timings)
 }

@@ -5,7 +5,7 @@
 
 use crate::backend::{Backend, Kernels, Prefilter, with_kernels};
 use crate::error::{Error, Result};
-use crate::placement::{self, Place, texel_bytes};
+use crate::placement::{self, texel_bytes};
 use crate::settings::{Field, Settings};
 use crate::texture::{Cube, Equirect, Lut, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
@@ -28,13 +28,8 @@ impl Backend {
             Backend::Cpu => None,
             Backend::Gpu(g) => Some(g.max_binding()),
         };
-        match placement::place_buffer(needs, binds) {
-            Place::Device => f(self),
-            place => {
-                placement::note(what, place, "the device");
-                f(&Backend::Cpu)
-            }
-        }
+        let cpu = Backend::Cpu;
+        f(placement::run(placement::place_buffer(needs, binds), || what.to_string(), || self, || &cpu))
     }
 
     internal! {
@@ -63,7 +58,7 @@ impl Backend {
         /// texel, the image centre facing `facing`, and its full mip chain.
         pub fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Cube> {
             let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
-            let needs = texel_bytes(splitsum_shaders::equirect::pyramid_len(env.width, env.height) as u64).max(texel_bytes(layout.texel_count() as u64));
+            let needs = placement::resampling_buffer(env.width, env.height, layout);
             self.placed("resampling the equirect", needs, |b| {
                 with_kernels!(b, k => Ok(Cube { layout, texels: k.read(&k.equirect_to_cube(env, size, supersample, facing)?)? }))
             })
@@ -115,7 +110,7 @@ impl Backend {
             }
             let exact = crate::settings::exact_levels(lobe, roughness, samples, exact, src.layout);
             let job = Prefilter { what: "prefiltered", lobe, layout: out, roughness, levels, samples, exact: &exact, lod_bias };
-            let needs = texel_bytes(src.texels.len() as u64).max(3 * texel_bytes(out.texel_count() as u64));
+            let needs = placement::sums_buffer(src.texels.len() as u64, out);
             self.placed("the prefiltered cube", needs, |b| {
                 with_kernels!(b, k => {
                     let t = k.upload("source cube", &src.texels)?;
@@ -128,7 +123,7 @@ impl Backend {
     internal! {
         /// The irradiance cube (`E/π`) of face size `size` from level `level` of `src`.
         pub fn irradiance(&self, src: &Cube, level: u32, size: u32) -> Result<Cube> {
-            let needs = texel_bytes(src.texels.len() as u64).max(3 * texel_bytes(CubeLayout::new(size, 1).texel_count() as u64));
+            let needs = placement::sums_buffer(src.texels.len() as u64, CubeLayout::new(size, 1));
             self.placed("the irradiance", needs, |b| {
                 with_kernels!(b, k => {
                     let t = k.upload("source cube", &src.texels)?;
@@ -169,7 +164,7 @@ impl Backend {
                 ProbeMode::Irradiance => FACES * layout.level_size(p.src_level).pow(2),
                 _ => 1,
             };
-            let needs = texel_bytes((texels.len() + probes.len()) as u64).max(3 * texel_bytes(probes.len() as u64));
+            let needs = placement::probes_buffer(texels.len() as u64, probes.len() as u64);
             let raw = self.placed("the probes", needs, |b| with_kernels!(b, k => k.probe_raw(p, texels, probes, terms)))?;
             let partial = |i: usize| splitsum_shaders::math::MeanPartial { sum: raw[3 * i], carry: raw[3 * i + 1], weight: raw[3 * i + 2] };
             Ok(raw

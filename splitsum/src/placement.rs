@@ -28,21 +28,40 @@ pub const fn texel_bytes(texels: u64) -> u64 {
     texels * 16
 }
 
+/// The largest buffer of resampling a `width`×`height` equirect to a cube of `layout`: its
+/// row pyramid, or the cube.
+pub fn resampling_buffer(width: u32, height: u32, layout: CubeLayout) -> u64 {
+    texel_bytes(splitsum_shaders::equirect::pyramid_len(width, height) as u64).max(texel_bytes(layout.texel_count() as u64))
+}
+
+/// The largest buffer of a sum over a source of `source_texels` texels into a cube of
+/// `out` (a prefiltered cube, the irradiance): the source, or the partial sums (three
+/// texels per texel).
+pub fn sums_buffer(source_texels: u64, out: CubeLayout) -> u64 {
+    texel_bytes(source_texels).max(3 * texel_bytes(out.texel_count() as u64))
+}
+
+/// The largest buffer of `probes` probes over `texels` texels: their input, or their
+/// partial sums (three texels per probe).
+pub fn probes_buffer(texels: u64, probes: u64) -> u64 {
+    texel_bytes(texels + probes).max(3 * texel_bytes(probes))
+}
+
 /// The largest storage buffer step `p` of `job` binds on a device, in bytes: the source
 /// cube (every step after it reads it whole), a prefiltered cube's or the irradiance's
-/// partial sums (three texels per texel), the equirect's row pyramid, a table.
+/// partial sums, the equirect's row pyramid, a table.
 pub fn largest_buffer(p: Product, job: &Job) -> u64 {
+    let source = job.source_layout();
     let cube = |l: CubeLayout| texel_bytes(l.texel_count() as u64);
-    let source = cube(job.source_layout());
     match p {
         Product::SourceCube => match job.input {
-            InputShape::Equirect { width, height } => source.max(texel_bytes(splitsum_shaders::equirect::pyramid_len(width, height) as u64)),
-            InputShape::Cube { size } => source.max(cube(CubeLayout::new(size, CubeLayout::full_chain(size)))),
-            InputShape::Unknown => source,
+            InputShape::Equirect { width, height } => resampling_buffer(width, height, source),
+            InputShape::Cube { size } => cube(source).max(cube(CubeLayout::new(size, CubeLayout::full_chain(size)))),
+            InputShape::Unknown => cube(source),
         },
-        p if p.lobe().is_some() => source.max(3 * cube(job.specular_layout())),
-        Product::Irradiance => source.max(3 * cube(job.irradiance_layout())),
-        Product::Sh9 => source,
+        p if p.lobe().is_some() => sums_buffer(source.texel_count() as u64, job.specular_layout()),
+        Product::Irradiance => sums_buffer(source.texel_count() as u64, job.irradiance_layout()),
+        Product::Sh9 => cube(source),
         Product::BrdfTable => texel_bytes((job.lut_size as u64).pow(2)),
         Product::SheenTables => texel_bytes((crate::product::SHEEN_TABLE_SIZE as u64).pow(2)),
         _ => unreachable!("{p} is a prefiltered cube, matched above"),
@@ -63,11 +82,23 @@ pub fn place(p: Product, job: &Job, binds: Option<u64>) -> Place {
     place_buffer(largest_buffer(p, job), binds)
 }
 
-/// A note that `what` runs on the CPU, for a step placed on the host.
-pub fn note(what: &str, place: Place, device: &str) {
+/// Runs `on_device` where `place` says the device, otherwise `on_host`, with a note that
+/// `what()` runs on the CPU and why.
+pub fn run<T>(place: Place, what: impl FnOnce() -> String, on_device: impl FnOnce() -> T, on_host: impl FnOnce() -> T) -> T {
+    match place {
+        Place::Device => on_device(),
+        Place::Host { .. } => {
+            note(&what(), place);
+            on_host()
+        }
+    }
+}
+
+/// A note that `what` runs on the CPU and why, for a step placed on the host.
+pub fn note(what: &str, place: Place) {
     if let Place::Host { needs, binds } = place {
         crate::progress::note(&format!(
-            "note: {what} needs a {:.0} MiB buffer, more than {device} binds ({:.0} MiB): running this step on the CPU",
+            "note: {what} needs a {:.0} MiB buffer, more than the device binds ({:.0} MiB): running this step on the CPU",
             needs as f64 / 1048576.0,
             binds as f64 / 1048576.0
         ));

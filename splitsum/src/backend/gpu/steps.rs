@@ -6,6 +6,7 @@ use super::kernel::{self, Kernel};
 use super::{Dispatch, Gpu};
 use crate::backend::kernels::{Kernels, Prefilter, chunks};
 use crate::error::{Error, Result};
+use crate::placement::{self, texel_bytes as bytes};
 use crate::texture::{Equirect, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::choice::Choice;
@@ -25,20 +26,14 @@ pub struct Texels {
     pub count: u32,
 }
 
-/// Bytes of `texels` RGBA f32 texels.
-fn bytes(texels: u64) -> u64 {
-    texels * 16
-}
-
 impl Gpu {
-    /// Refuses a step whose largest buffer is more than one storage binding of the device
-    /// holds: the bake sequence places such a step on the CPU beforehand
+    /// Refuses a step whose largest buffer (`needs` bytes) is more than one storage binding
+    /// of the device holds: the bake sequence places such a step on the CPU beforehand
     /// (`crate::placement`), and so do the host-data conveniences (`crate::host`).
-    fn binds(&self, step: &str, buffers: &[u64]) -> Result<()> {
-        let needs = buffers.iter().copied().max().unwrap_or(0);
-        match crate::placement::place_buffer(needs, Some(self.max_binding())) {
-            crate::placement::Place::Device => Ok(()),
-            crate::placement::Place::Host { needs, binds } => Err(Error::gpu(format!(
+    fn binds(&self, step: &str, needs: u64) -> Result<()> {
+        match placement::place_buffer(needs, Some(self.max_binding())) {
+            placement::Place::Device => Ok(()),
+            placement::Place::Host { needs, binds } => Err(Error::gpu(format!(
                 "{step} needs a {:.0} MiB buffer, more than {} binds ({:.0} MiB): place it on the CPU (splitsum::placement)",
                 needs as f64 / 1048576.0,
                 self.info.name,
@@ -151,8 +146,7 @@ impl Kernels for Gpu {
     fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Texels> {
         let layout = CubeLayout::new(size, CubeLayout::full_chain(size));
         let (w, h) = (env.width, env.height);
-        let pyramid_bytes = bytes(equirect::pyramid_len(w, h) as u64);
-        self.binds(&format!("resampling the {w}×{h} equirect (its row pyramid)"), &[pyramid_bytes, bytes(layout.texel_count() as u64)])?;
+        self.binds(&format!("resampling the {w}×{h} equirect (its row pyramid)"), placement::resampling_buffer(w, h, layout))?;
         let mut texels = env.texels.clone();
         texels.resize(equirect::pyramid_len(w, h) as usize, Vec4::ZERO);
         let pyramid = self.upload_bytes("equirect pyramid", bytemuck::cast_slice(&texels));
@@ -160,15 +154,14 @@ impl Kernels for Gpu {
     }
 
     fn build_mips(&self, cube: &mut Texels, layout: CubeLayout) -> Result<()> {
-        self.binds(&format!("the mips of the {}² cube", layout.size), &[bytes(cube.count as u64)])?;
+        self.binds(&format!("the mips of the {}² cube", layout.size), bytes(cube.count as u64))?;
         self.mips(&cube.buffer, layout);
         Ok(())
     }
 
     fn prefilter(&self, src: &Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Texels> {
         let out = job.layout;
-        let buffers = [bytes(src.count as u64), 3 * bytes(out.texel_count() as u64)];
-        self.binds(&format!("the {} cube from the {}² source cube", job.what, src_layout.size), &buffers)?;
+        self.binds(&format!("the {} cube from the {}² source cube", job.what, src_layout.size), placement::sums_buffer(src.count as u64, out))?;
         let accum = self.output("prefilter sums", 3 * bytes(out.texel_count() as u64))?;
         let result = self.texels(job.what, out.texel_count())?;
         for &m in job.levels {
@@ -209,8 +202,7 @@ impl Kernels for Gpu {
 
     fn irradiance(&self, src: &Texels, src_layout: CubeLayout, level: u32, size: u32) -> Result<Texels> {
         let layout = CubeLayout::new(size, 1);
-        let buffers = [bytes(src.count as u64), 3 * bytes(layout.texel_count() as u64)];
-        self.binds(&format!("the irradiance from the {}² source cube", src_layout.size), &buffers)?;
+        self.binds(&format!("the irradiance from the {}² source cube", src_layout.size), placement::sums_buffer(src.count as u64, layout))?;
         let accum = self.output("irradiance sums", 3 * bytes(layout.texel_count() as u64))?;
         let s = src_layout.level_size(level);
         // The summed level alone, as a one-level cube, followed by its geometry table.
@@ -231,7 +223,7 @@ impl Kernels for Gpu {
     }
 
     fn sh9(&self, src: &Texels, src_layout: CubeLayout, level: u32) -> Result<Sh9> {
-        self.binds(&format!("SH9 from the {}² source cube", src_layout.size), &[bytes(src.count as u64)])?;
+        self.binds(&format!("SH9 from the {}² source cube", src_layout.size), bytes(src.count as u64))?;
         let s = src_layout.level_size(level);
         let n = FACES * s * (SH9 as u32 + 1);
         let dst = self.texels("sh9 rows", n)?;
@@ -243,7 +235,7 @@ impl Kernels for Gpu {
 
     fn brdf_lut(&self, size: u32, samples: u32) -> Result<Texels> {
         let n = size * size;
-        self.binds("the BRDF table", &[bytes(n as u64)])?;
+        self.binds("the BRDF table", bytes(n as u64))?;
         self.ensure(&kernel::BRDF_LUT)?;
         self.ensure(&kernel::RESOLVE_LUT)?;
         let accum = self.output("brdf lut sums", bytes(n as u64))?;
@@ -258,7 +250,7 @@ impl Kernels for Gpu {
 
     fn brdf_table(&self, size: u32, masking: Masking) -> Result<Texels> {
         let n = size * size;
-        self.binds("the BRDF table", &[bytes(n as u64)])?;
+        self.binds("the BRDF table", bytes(n as u64))?;
         self.ensure(&kernel::BRDF_TABLE)?;
         let out = self.texels("brdf table", n)?;
         let per_texel = lut::QUADRATURE_MEAN_EVALUATIONS;
@@ -275,7 +267,7 @@ impl Kernels for Gpu {
     }
 
     fn probe_raw(&self, p: ProbeParams, texels: &[Vec4], probes: &[Vec4], terms: u32) -> Result<Vec<Vec4>> {
-        self.binds("the probes", &[bytes((texels.len() + probes.len()) as u64), 3 * bytes(probes.len() as u64)])?;
+        self.binds("the probes", placement::probes_buffer(texels.len() as u64, probes.len() as u64))?;
         self.ensure(&kernel::PROBE)?;
         let mut input = texels.to_vec();
         input.extend_from_slice(probes);
