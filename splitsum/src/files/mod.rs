@@ -216,7 +216,11 @@ pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
         let t = lut.texels[pos.y() * size + pos.x()];
         (t.x, t.y)
     });
-    let image = Image::from_channels((size, size), pixels);
+    // Its blocks written in order: the `exr` crate's default encoding leaves the order
+    // unspecified and writes blocks as its threads finish compressing them, so the same
+    // table made a different file in one of two runs of the same bake.
+    let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
+    let image = Image::from_encoded_channels((size, size), encoding, pixels);
     let mut buf = std::io::Cursor::new(Vec::new());
     image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file_caused(path, "could not encode", e))?;
     write_atomic(path, |w| w.write_all(buf.get_ref()))
@@ -267,6 +271,7 @@ pub fn write_rgb_exr(path: &Path, width: u32, height: u32, pixels: &[splitsum_sh
     let layer = Layer::new(
         (w, height as usize),
         attributes,
+        // Scan lines written in order (its line order is `Increasing`).
         Encoding::SMALL_LOSSLESS,
         SpecificChannels::rgb(|pos: Vec2<usize>| {
             let t = pixels[pos.y() * w + pos.x()];
@@ -302,3 +307,29 @@ pub use manifest::{OUTPUT_MANIFEST, Verified, check_replaceable};
 /// process is interrupted (SIGINT, SIGTERM, SIGHUP), under this lock, which a commit holds
 /// while it swaps folders and removes the old one.
 static PENDING: std::sync::Mutex<Vec<(PathBuf, Vec<PathBuf>)>> = std::sync::Mutex::new(Vec::new());
+
+#[cfg(test)]
+mod tests {
+    use splitsum_shaders::glam::Vec2;
+
+    /// The same table makes the same bytes every time: blocks top to bottom.
+    #[test]
+    fn a_table_exr_is_the_same_bytes_every_time() {
+        let dir = std::env::temp_dir().join(format!("splitsum-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let size = 256u32;
+        let lut = crate::texture::Lut { size, texels: (0..size * size).map(|i| Vec2::new((i % 97) as f32 * 0.37, (i as f32).sin())).collect() };
+        let write = |k: u32| {
+            let path = dir.join(format!("{k}.exr"));
+            super::write_lut_exr(&path, &lut).unwrap();
+            std::fs::read(&path).unwrap()
+        };
+        let first = write(0);
+        for k in 1..8 {
+            assert!(write(k) == first, "write {k} differs from the first");
+        }
+        let meta = exr::meta::MetaData::read_from_buffered(std::io::Cursor::new(&first), false).unwrap();
+        assert_eq!(meta.headers[0].line_order, exr::prelude::LineOrder::Increasing);
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}
