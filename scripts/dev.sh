@@ -54,7 +54,7 @@ spirv_hash() {
     git rev-parse --is-inside-work-tree >/dev/null 2>&1 || return 0
     {
         echo "$NIGHTLY"
-        git ls-files -z --cached --others --exclude-standard -- shaders/src shaders/Cargo.toml xtask Cargo.toml Cargo.lock spirv/src/splitsum_shaders.spv spirv/src/linkage.rs \
+        git ls-files -z --cached --others --exclude-standard -- shaders/src shaders/Cargo.toml xtask Cargo.toml Cargo.lock spirv/src/modules spirv/src/linkage.rs \
             | sort -z | xargs -0 sha256sum
     } | sha256sum | cut -d' ' -f1
 }

@@ -1,4 +1,4 @@
-//! The committed SPIR-V module through naga at the version wgpu uses (30.0.1), as wgpu
+//! The committed SPIR-V modules (one per entry point) through naga at the version wgpu uses (30.0.1), as wgpu
 //! feeds it to every API it has: parsed with wgpu's own options, validated, and written
 //! for Metal (MSL), DX12 (HLSL) and GL (GLSL ES 3.10); the lowest Metal and HLSL
 //! shader-model versions that take it, which the README states; and the loop shape naga
@@ -10,64 +10,70 @@
 use naga::{Block, Expression, Function, Handle, Statement};
 use std::collections::HashSet;
 
-fn module() -> (naga::Module, naga::valid::ModuleInfo) {
-    // wgpu's own options for SPIR-V input (`wgpu::backend::wgpu_core`, create_shader_module).
-    let options = naga::front::spv::Options { adjust_coordinate_space: false, strict_capabilities: true, block_ctx_dump_prefix: None };
-    let module = naga::front::spv::parse_u8_slice(bytemuck::cast_slice(splitsum_spirv::words()), &options).expect("naga parses the module");
-    let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("naga validates the module with the default capabilities: {e:?}"));
-    (module, info)
+/// Every entry point's module, parsed and validated as wgpu does.
+fn modules() -> Vec<(splitsum_spirv::EntryPoint, naga::Module, naga::valid::ModuleInfo)> {
+    splitsum_spirv::ENTRY_POINTS
+        .iter()
+        .map(|e| {
+            // wgpu's own options for SPIR-V input (`wgpu::backend::wgpu_core`, create_shader_module).
+            let options = naga::front::spv::Options { adjust_coordinate_space: false, strict_capabilities: true, block_ctx_dump_prefix: None };
+            let module = naga::front::spv::parse_u8_slice(e.bytes(), &options).unwrap_or_else(|err| panic!("naga parses {}: {err:?}", e.name));
+            let info = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+                .validate(&module)
+                .unwrap_or_else(|err| panic!("naga validates {} with the default capabilities: {err:?}", e.name));
+            assert_eq!(module.entry_points.len(), 1, "{}'s module holds its entry point alone", e.name);
+            assert_eq!(module.entry_points[0].name, e.name, "the linkage names the module's entry point");
+            (*e, module, info)
+        })
+        .collect()
 }
 
-/// Every entry point of the module writes as MSL from Metal 1.2, not before (the bit
-/// reversal of the radical inverse needs `reverse_bits`, which naga writes from 1.2; naga's
-/// default, 1.0, stops there), and as HLSL from shader model 5.0 (wgpu's DX12 backend uses
-/// 5.1 with FXC, 6.0 and up with DXC).
+/// Every entry point writes as MSL from Metal 1.2, not before (the bit reversal of the
+/// radical inverse needs `reverse_bits`, which naga writes from 1.2; naga's default, 1.0,
+/// stops there), and as HLSL from shader model 5.0 (wgpu's DX12 backend uses 5.1 with FXC,
+/// 6.0 and up with DXC).
 #[test]
-fn the_module_translates_for_metal_and_dx12() {
-    let (module, info) = module();
-    let msl = |version: (u8, u8)| {
-        let options = naga::back::msl::Options { lang_version: version, ..Default::default() };
-        naga::back::msl::write_string(&module, &info, &options, &naga::back::msl::PipelineOptions::default())
-    };
+fn the_modules_translate_for_metal_and_dx12() {
     let versions = [(1, 0), (1, 1), (1, 2), (2, 0), (2, 1), (2, 2), (2, 3), (2, 4), (3, 0)];
-    let first = versions.iter().position(|&v| msl(v).is_ok()).expect("some Metal version takes the module");
-    for &v in &versions[first..] {
-        if let Err(e) = msl(v) {
-            panic!("Metal {}.{}: {e:?}", v.0, v.1);
+    let mut firsts = Vec::new();
+    for (e, module, info) in modules() {
+        let msl = |version: (u8, u8)| {
+            let options = naga::back::msl::Options { lang_version: version, ..Default::default() };
+            naga::back::msl::write_string(&module, &info, &options, &naga::back::msl::PipelineOptions::default())
+        };
+        let first = versions.iter().position(|&v| msl(v).is_ok()).unwrap_or_else(|| panic!("some Metal version takes {}", e.name));
+        for &v in &versions[first..] {
+            if let Err(err) = msl(v) {
+                panic!("{}, Metal {}.{}: {err:?}", e.name, v.0, v.1);
+            }
         }
-    }
-    let (major, minor) = versions[first];
-    eprintln!("MSL: every entry point from Metal {major}.{minor}; before it: {:?}", msl(versions[first.saturating_sub(1)]).err());
-    assert_eq!((major, minor), (1, 2), "the README states the minimum Metal version");
+        firsts.push(versions[first]);
 
-    use naga::back::hlsl::ShaderModel;
-    let hlsl = |model: ShaderModel| {
-        let options = naga::back::hlsl::Options { shader_model: model, fake_missing_bindings: true, ..Default::default() };
-        let mut out = String::new();
-        naga::back::hlsl::Writer::new(&mut out, &options, &Default::default()).write(&module, &info, None).map(|_| out.len())
-    };
-    let models = [ShaderModel::V5_0, ShaderModel::V5_1, ShaderModel::V6_0];
-    for m in models {
-        if let Err(e) = hlsl(m) {
-            panic!("HLSL {m:?}: {e:?}");
+        use naga::back::hlsl::ShaderModel;
+        for m in [ShaderModel::V5_0, ShaderModel::V5_1, ShaderModel::V6_0] {
+            let options = naga::back::hlsl::Options { shader_model: m, fake_missing_bindings: true, ..Default::default() };
+            let mut out = String::new();
+            if let Err(err) = naga::back::hlsl::Writer::new(&mut out, &options, &Default::default()).write(&module, &info, None) {
+                panic!("{}, HLSL {m:?}: {err:?}", e.name);
+            }
         }
     }
-    eprintln!("HLSL: every entry point from shader model 5.0");
+    let (major, minor) = firsts.iter().copied().max().expect("entry points");
+    eprintln!("MSL: every entry point from Metal {major}.{minor}; HLSL: from shader model 5.0");
+    assert_eq!((major, minor), (1, 2), "the README states the minimum Metal version");
 }
 
 /// Every compute kernel writes as GLSL ES 3.10, what wgpu's GL backend compiles.
 #[test]
 fn the_kernels_translate_for_gl() {
-    let (module, info) = module();
-    for ep in module.entry_points.iter().filter(|e| e.stage == naga::ShaderStage::Compute) {
+    for (e, module, info) in modules().into_iter().filter(|(e, ..)| e.stage == splitsum_spirv::Stage::Compute) {
+        let ep = &module.entry_points[0];
         let options = naga::back::glsl::Options { version: naga::back::glsl::Version::new_gles(310), ..Default::default() };
         let pipeline = naga::back::glsl::PipelineOptions { shader_stage: naga::ShaderStage::Compute, entry_point: ep.name.clone(), multiview: None };
         let mut out = String::new();
         let mut writer = naga::back::glsl::Writer::new(&mut out, &module, &info, &options, &pipeline, naga::proc::BoundsCheckPolicies::default())
-            .unwrap_or_else(|e| panic!("{}: {e:?}", ep.name));
-        writer.write().unwrap_or_else(|e| panic!("{}: {e:?}", ep.name));
+            .unwrap_or_else(|err| panic!("{}: {err:?}", e.name));
+        writer.write().unwrap_or_else(|err| panic!("{}: {err:?}", e.name));
     }
 }
 
@@ -147,8 +153,12 @@ fn hazards(block: &Block, f: &Function) -> usize {
 /// were affected and on GL the BRDF table came out 15–44 % low).
 #[test]
 fn no_loop_stops_on_a_condition_its_continuing_block_overwrote() {
-    let (module, _) = module();
-    let functions = module.functions.iter().map(|(_, f)| f).chain(module.entry_points.iter().map(|e| &e.function));
-    let n: usize = functions.map(|f| hazards(&f.body, f)).sum();
+    let n: usize = modules()
+        .iter()
+        .map(|(_, module, _)| {
+            let functions = module.functions.iter().map(|(_, f)| f).chain(module.entry_points.iter().map(|e| &e.function));
+            functions.map(|f| hazards(&f.body, f)).sum::<usize>()
+        })
+        .sum();
     assert_eq!(n, 0, "{n} loops would drop their last iteration on GL, Metal and DX12");
 }

@@ -39,10 +39,11 @@ pub fn default_dir() -> PathBuf {
 }
 
 /// The key of a bake: BLAKE3 of the format, the environment's identity (the hash of its
-/// bytes, `environment::identity`), the plan (as JSON), the backend and the SPIR-V module.
+/// bytes, `environment::identity`), the plan (as JSON), the backend and the SPIR-V modules.
 pub fn key(environment: &[u8], plan_json: &str, backend: &str) -> String {
     let mut h = blake3::Hasher::new();
-    for part in [FORMAT.as_bytes(), environment, plan_json.as_bytes(), backend.as_bytes(), splitsum_spirv::bytes()] {
+    let modules = splitsum_spirv::ENTRY_POINTS.iter().map(|e| e.bytes());
+    for part in [FORMAT.as_bytes(), environment, plan_json.as_bytes(), backend.as_bytes()].into_iter().chain(modules) {
         h.update(&(part.len() as u64).to_le_bytes());
         h.update(part);
     }

@@ -1,7 +1,8 @@
-//! `xtask spirv [--check]`: compiles `shaders/` to SPIR-V with rust-gpu and writes
-//! `spirv/src/splitsum_shaders.spv` and `spirv/src/linkage.rs`, the entry points'
-//! names, stages, workgroup sizes and bindings reflected from the module itself.
-//! `--check` compiles and compares instead, failing if either committed file differs.
+//! `xtask spirv [--check]`: compiles `shaders/` to SPIR-V with rust-gpu and writes one
+//! module per entry point, `spirv/src/modules/NAME.spv`, and `spirv/src/linkage.rs`, the
+//! entry points' names, stages, workgroup sizes and bindings reflected from the modules
+//! themselves. `--check` compiles and compares instead, failing if any committed file
+//! differs or is left over.
 //!
 //! This is the only place rust-gpu runs: the workspace builds on stable from the committed
 //! files (renderling's pattern: committed SPIR-V with generated linkage, regenerated and
@@ -9,7 +10,7 @@
 
 use rspirv::dr::{Instruction, Module, Operand};
 use rspirv::spirv::{Decoration, Dim, ExecutionMode, ExecutionModel, Op, StorageClass};
-use spirv_builder::{ShaderPanicStrategy, SpirvBuilder};
+use spirv_builder::{ModuleResult, ShaderPanicStrategy, SpirvBuilder};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -46,41 +47,80 @@ fn run(check: bool) -> Result<bool, Error> {
     let mut builder = SpirvBuilder::new(root.join("shaders"), "spirv-unknown-vulkan1.1");
     builder.shader_panic_strategy = ShaderPanicStrategy::SilentExit;
     builder.release = true;
+    // One module per entry point, each holding only what its entry point calls (rust-gpu
+    // splits the linked module and removes the dead code of each part): a pipeline
+    // compiles only its own code. One module with every entry point took a browser's GPU
+    // process past 11 GB compiling one kernel (issue 33).
+    builder.multimodule = true;
     // The workspace pins stable; the shader crate must build with the nightly this xtask
     // runs on (xtask/rust-toolchain.toml), so say so explicitly to the nested cargo.
     builder.toolchain_overwrite = std::env::var("RUSTUP_TOOLCHAIN").ok();
     let result = builder.build()?;
-    let spv = std::fs::read(result.module.unwrap_single())?;
-    let words: Vec<u32> = spv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-    let mut module = rspirv::dr::load_words(&words).map_err(|e| format!("reading the module back: {e}"))?;
-    let rewritten = latch_conditions_local(&mut module);
+    let ModuleResult::MultiModule(parts) = &result.module else { return Err("rust-gpu returned one module where one per entry point was asked".into()) };
+    let (mut rewritten, mut renamed) = (0, 0);
+    let mut entries = BTreeMap::new();
+    let mut outputs = Vec::new();
+    for path in parts.values() {
+        let spv = std::fs::read(path)?;
+        let words: Vec<u32> = spv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        let mut module = rspirv::dr::load_words(&words).map_err(|e| format!("reading {} back: {e}", path.display()))?;
+        rewritten += latch_conditions_local(&mut module);
+        renamed += wgsl_entry_names(&mut module)?;
+        let spv: Vec<u8> = {
+            use rspirv::binary::Assemble;
+            module.assemble().iter().flat_map(|w| w.to_le_bytes()).collect()
+        };
+        let found = entry_points(&module)?;
+        let name = match found.keys().collect::<Vec<_>>()[..] {
+            [name] => name.clone(),
+            _ => return Err(format!("{} holds {} entry points, not one", path.display(), found.len()).into()),
+        };
+        outputs.push((root.join(MODULES).join(format!("{name}.spv")), spv));
+        entries.extend(found);
+    }
     eprintln!("xtask: {rewritten} loop latches given a condition of their own (see latch_conditions_local)");
-    let renamed = wgsl_entry_names(&mut module)?;
     eprintln!("xtask: {renamed} entry points named as WGSL identifiers (see wgsl_entry_names)");
-    let spv: Vec<u8> = {
-        use rspirv::binary::Assemble;
-        module.assemble().iter().flat_map(|w| w.to_le_bytes()).collect()
-    };
-    let linkage = linkage(&module)?;
+    eprintln!("xtask: {} modules, one per entry point", outputs.len());
+    outputs.push((root.join("spirv/src/linkage.rs"), linkage(&entries).into_bytes()));
 
-    let outputs = [(root.join("spirv/src/splitsum_shaders.spv"), spv), (root.join("spirv/src/linkage.rs"), linkage.into_bytes())];
     let mut same = true;
+    // A module left from an entry point that is gone.
+    let wanted: BTreeSet<&PathBuf> = outputs.iter().map(|(p, _)| p).collect();
+    for stale in std::fs::read_dir(root.join(MODULES)).into_iter().flatten().flatten().map(|e| e.path()) {
+        if !wanted.contains(&stale) {
+            let shown = stale.strip_prefix(&root).unwrap_or(&stale).display().to_string();
+            if check {
+                eprintln!("xtask: {shown} is no entry point's module; run `bash scripts/dev.sh spirv` and commit its removal");
+                same = false;
+            } else {
+                std::fs::remove_file(&stale)?;
+                eprintln!("xtask: removed {shown}");
+            }
+        }
+    }
+    if !check {
+        std::fs::create_dir_all(root.join(MODULES))?;
+    }
     for (path, bytes) in &outputs {
         let shown = path.strip_prefix(&root).unwrap_or(path).display();
         if check {
             if std::fs::read(path).ok().as_deref() != Some(bytes.as_slice()) {
                 eprintln!("xtask: {shown} differs from what shaders/ compiles to; run `bash scripts/dev.sh spirv` and commit it");
                 same = false;
-            } else {
-                eprintln!("xtask: {shown} is up to date");
             }
-        } else {
+        } else if std::fs::read(path).ok().as_deref() != Some(bytes.as_slice()) {
             std::fs::write(path, bytes)?;
             eprintln!("xtask: wrote {shown}");
         }
     }
+    if check && same {
+        eprintln!("xtask: the {} files under spirv/src are up to date", outputs.len());
+    }
     Ok(same)
 }
+
+/// Where the modules go, one per entry point, named as the entry point.
+const MODULES: &str = "spirv/src/modules";
 
 /// Gives every loop whose latch (continue block) branches on a condition computed
 /// elsewhere in the loop a copy of that condition of its own: `%c2 = OpPhi %bool %c %pred…`
@@ -300,9 +340,13 @@ fn written_variables(module: &Module) -> BTreeSet<u32> {
     written
 }
 
-/// `spirv/src/linkage.rs`: every entry point with its stage, workgroup size and the
-/// bindings its call tree uses.
-fn linkage(module: &Module) -> Result<String, Error> {
+/// An entry point's stage, workgroup size and bindings (`splitsum_spirv::Resource` spelled
+/// out, by group and binding).
+type Entry = (&'static str, [u32; 3], BTreeMap<(u32, u32), String>);
+
+/// Every entry point of `module` with its stage, workgroup size and the bindings its call
+/// tree uses.
+fn entry_points(module: &Module) -> Result<BTreeMap<String, Entry>, Error> {
     let mut decorations: HashMap<u32, (Option<u32>, Option<u32>)> = HashMap::new();
     for a in module.annotations.iter().filter(|a| a.class.opcode == Op::Decorate) {
         let (Some(Operand::IdRef(target)), Some(Operand::Decoration(d))) = (a.operands.first(), a.operands.get(1)) else { continue };
@@ -368,28 +412,35 @@ fn linkage(module: &Module) -> Result<String, Error> {
         }
         entries.insert(name.clone(), (stage, local_size.get(f).copied().unwrap_or([1, 1, 1]), bindings));
     }
+    Ok(entries)
+}
 
+/// `spirv/src/linkage.rs`: every entry point with its stage, workgroup size, the bindings
+/// its call tree uses and its module.
+fn linkage(entries: &BTreeMap<String, Entry>) -> String {
     let mut out = String::from(
-        "// @generated by `bash scripts/dev.sh spirv` (xtask/src/main.rs), reflected from\n\
-         // splitsum_shaders.spv. Do not edit: change shaders/ and regenerate.\n\n\
-         use crate::{Binding, Dimension, EntryPoint, Resource, Stage};\n",
+        "// @generated by `bash scripts/dev.sh spirv` (xtask/src/main.rs), reflected from the\n\
+         // modules in modules/, one per entry point. Do not edit: change shaders/ and regenerate.\n\n\
+         use crate::{Binding, Dimension, EntryPoint, Module, Resource, Stage};\n",
     );
-    let mut compute = Vec::new();
-    for (name, (stage, size, bindings)) in &entries {
+    let (mut compute, mut all) = (Vec::new(), Vec::new());
+    for (name, (stage, size, bindings)) in entries {
         let ident = name.replace("::", "_").to_uppercase();
         let _ = write!(out, "\n/// `{name}`.\npub const {ident}: EntryPoint = EntryPoint {{\n    name: \"{name}\",\n    stage: Stage::{stage},\n    workgroup_size: {size:?},\n    bindings: &[\n");
         for ((group, binding), resource) in bindings {
             let _ = writeln!(out, "        Binding {{ group: {group}, binding: {binding}, resource: {resource} }},");
         }
-        out.push_str("    ],\n};\n");
+        let file = format!("modules/{name}.spv");
+        let _ = write!(
+            out,
+            "    ],\n    module: &{ident}_MODULE,\n}};\nstatic {ident}_MODULE: Module<[u8; include_bytes!(\"{file}\").len()]> = Module(*include_bytes!(\"{file}\"));\n"
+        );
         if *stage == "Compute" {
-            compute.push(ident);
+            compute.push(ident.clone());
         }
+        all.push(ident);
     }
     let _ = write!(out, "\n/// Every compute entry point.\npub const KERNELS: [EntryPoint; {}] = [{}];\n", compute.len(), compute.join(", "));
-    if out.contains("Dimension::") {
-        Ok(out)
-    } else {
-        Ok(out.replace("Binding, Dimension, EntryPoint", "Binding, EntryPoint"))
-    }
+    let _ = write!(out, "\n/// Every entry point.\npub const ENTRY_POINTS: [EntryPoint; {}] = [{}];\n", all.len(), all.join(", "));
+    if out.contains("Dimension::") { out } else { out.replace("Binding, Dimension, EntryPoint", "Binding, EntryPoint") }
 }

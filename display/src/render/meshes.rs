@@ -96,7 +96,7 @@ impl GpuModel {
             label: Some("mesh"),
             layout: Some(&self.pipeline_layout),
             vertex: wgpu::VertexState {
-                module: &gpu.module,
+                module: &gpu.module(&spirv::DISPLAY_MESH_VS),
                 entry_point: Some(spirv::DISPLAY_MESH_VS.name),
                 compilation_options: Default::default(),
                 buffers: &[Some(wgpu::VertexBufferLayout {
@@ -119,7 +119,7 @@ impl GpuModel {
             }),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
-                module: &gpu.module,
+                module: &gpu.module(&spirv::DISPLAY_MESH_FS),
                 entry_point: Some(spirv::DISPLAY_MESH_FS.name),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],

@@ -334,7 +334,7 @@ impl GpuScene {
             label: Some("scene"),
             layout: Some(&self.pipeline_layout),
             vertex: wgpu::VertexState {
-                module: &gpu.module,
+                module: &gpu.module(&spirv::DISPLAY_FULLSCREEN_VS),
                 entry_point: Some(spirv::DISPLAY_FULLSCREEN_VS.name),
                 compilation_options: Default::default(),
                 buffers: &[],
@@ -349,7 +349,7 @@ impl GpuScene {
             }),
             multisample: wgpu::MultisampleState::default(),
             fragment: Some(wgpu::FragmentState {
-                module: &gpu.module,
+                module: &gpu.module(&spirv::DISPLAY_SCENE_FS),
                 entry_point: Some(spirv::DISPLAY_SCENE_FS.name),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],

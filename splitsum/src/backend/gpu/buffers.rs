@@ -5,7 +5,6 @@ use super::{group_layout, kernel_pipeline};
 use crate::error::{Error, Result};
 use splitsum_shaders::cubemap::{CubeLayout, FACES};
 use splitsum_spirv::Resource;
-use std::borrow::Cow;
 
 /// Whether `device` copies cube textures to buffers. wgpu's GL backend makes every square
 /// six-layer texture a GL cube map and copies none of them ("Not implemented yet: cubemap
@@ -43,11 +42,7 @@ impl CubeReader {
             })
             .collect();
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &entries });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("splitsum-shaders"),
-            source: wgpu::ShaderSource::SpirV(Cow::Borrowed(splitsum_spirv::words())),
-        });
-        let pipeline = kernel_pipeline(device, &module, k, &layout);
+        let pipeline = kernel_pipeline(device, &super::shader_module(device, k), k, &layout);
         // Nearest in every direction: the texel at the sampled point, at the exact level.
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor { label: Some("splitsum cube reader"), ..Default::default() });
         Self { pipeline, layout, sampler }

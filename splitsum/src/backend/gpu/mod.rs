@@ -1,6 +1,7 @@
 //! The GPU backend: wgpu running the rust-gpu kernels of `splitsum_shaders::kernels` from
-//! the committed SPIR-V module of `splitsum-spirv`. Every entry point's name, workgroup
-//! size and bindings come from that crate's generated linkage; nothing here spells one.
+//! the committed SPIR-V modules of `splitsum-spirv`, one per entry point. Every entry
+//! point's name, workgroup size, bindings and module come from that crate's generated
+//! linkage; nothing here spells one.
 //!
 //! Start-up (device and the pipelines of every kernel a bake runs) happens in [`Gpu::new`]
 //! or [`Gpu::on_device`], so that the time of a bake excludes it; the kernels only tools
@@ -29,8 +30,6 @@ pub struct Gpu {
     pub instance: Option<wgpu::Instance>,
     /// The adapter, likewise.
     pub adapter: Option<wgpu::Adapter>,
-    /// The SPIR-V module of `splitsum-shaders` (compute, vertex and fragment entry points).
-    pub module: wgpu::ShaderModule,
     /// The device.
     pub device: wgpu::Device,
     /// Its queue.
@@ -244,21 +243,13 @@ impl Gpu {
     pub async fn on_device_async(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Self> {
         let info = device.adapter_info();
         check_limits(&info, &device.limits())?;
-        let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("splitsum-shaders"),
-            source: wgpu::ShaderSource::SpirV(Cow::Borrowed(splitsum_spirv::words())),
-        });
-        // As text: `wgpu::Error` is not `Send` in a browser.
-        if let Some(e) = scope.pop().await {
-            return Err(Error::gpu_caused(format!("the shader module did not validate on {}", info.name), e.to_string()));
-        }
-        // Each pipeline checked in an error scope of its own, so that an error names its
-        // kernel; those built on demand are not built here (`at_start_up`).
+        // Each pipeline (and its module) checked in an error scope of its own, so that an
+        // error names its kernel; those built on demand are not built here (`at_start_up`).
         let kernels: Vec<&EntryPoint> = kernel::ALL.iter().filter(|(k, on_demand)| at_start_up(k, *on_demand)).map(|(k, _)| *k).collect();
         let build = |k: &EntryPoint| {
             let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
+            let module = shader_module(device, k);
             let pipeline = kernel_pipeline(device, &module, k, &layout);
             (pipeline, layout, scope)
         };
@@ -298,7 +289,23 @@ impl Gpu {
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
-        Ok(Self { instance: None, adapter: None, module, device: device.clone(), queue: queue.clone(), info, pipelines: std::sync::RwLock::new(pipelines), empty })
+        Ok(Self {
+            instance: None,
+            adapter: None,
+            device: device.clone(),
+            queue: queue.clone(),
+            info,
+            pipelines: std::sync::RwLock::new(pipelines),
+            empty,
+        })
+    }
+
+    internal! {
+        /// The shader module of entry point `e` on this device (the viewer's vertex and
+        /// fragment shaders; each entry point has a module of its own).
+        pub fn module(&self, e: &EntryPoint) -> wgpu::ShaderModule {
+            shader_module(&self.device, e)
+        }
     }
 
     /// Builds the pipeline of kernel `k` if it is not built yet (a kernel built on
@@ -311,7 +318,7 @@ impl Gpu {
         }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let layout = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
-        let pipeline = kernel_pipeline(&self.device, &self.module, k, &layout);
+        let pipeline = kernel_pipeline(&self.device, &shader_module(&self.device, k), k, &layout);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::gpu_caused(format!("kernel {} did not validate on {}", k.name, self.info.name), e.to_string()));
         }
@@ -485,6 +492,11 @@ fn check_limits(info: &wgpu::AdapterInfo, l: &wgpu::Limits) -> Result<()> {
         api_name(info.backend),
         missing.join(", ")
     )))
+}
+
+/// The shader module of entry point `e` (its own module, holding only what it calls).
+pub fn shader_module(device: &wgpu::Device, e: &EntryPoint) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(e.name), source: wgpu::ShaderSource::SpirV(Cow::Borrowed(e.words())) })
 }
 
 /// The compute pipeline of kernel `k` of `module`, with the bind group layout `layout`.
