@@ -25,6 +25,7 @@ const browser = await puppeteer.launch({
   executablePath: "/usr/bin/chromium",
   headless: true,
   protocolTimeout: 900_000,
+  dumpio: true,
   args: ["--no-sandbox", "--disable-gpu-sandbox", "--enable-unsafe-webgpu", "--use-webgpu-adapter=swiftshader", "--disable-background-networking",
          "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"],
 });

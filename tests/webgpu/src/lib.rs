@@ -2,7 +2,8 @@
 
 use splitsum::glam::Vec4;
 use splitsum::texture::Equirect;
-use splitsum::{Baker, Compute, Environment, Product, Settings, Source};
+use splitsum::environment::Environment;
+use splitsum::{Baker, Compute, Product, Settings, Source};
 use wasm_bindgen::prelude::*;
 
 #[wasm_bindgen]
