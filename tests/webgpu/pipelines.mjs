@@ -1,0 +1,46 @@
+// Each compute kernel's pipeline built alone in headless Chromium's WebGPU (SwiftShader),
+// from its module as WGSL, each in a fresh browser: the time to build it and the GPU
+// process's peak resident memory (issue 33: which kernels a browser cannot build).
+//
+//   mkdir -p target/wgsl && for f in spirv/src/modules/kernels_*.spv; do
+//       naga "$f" "target/wgsl/$(basename "$f" .spv).wgsl"; done
+//   (cd tests/webgpu && npm install) && node tests/webgpu/pipelines.mjs target/wgsl [NAME]
+//
+// Prints a line per kernel: name, WGSL size, milliseconds, peak MiB, and the error and
+// the device's loss message if any.
+import { createServer } from "node:http";
+import { readFile, readdir } from "node:fs/promises";
+import { execSync } from "node:child_process";
+import puppeteer from "puppeteer-core";
+const [dir, only] = process.argv.slice(2);
+const root = dir.endsWith("/") ? dir : dir + "/";
+// An empty page on loopback (a secure context, where WebGPU is offered).
+const server = createServer((req, res) => { res.writeHead(200, { "content-type": "text/html" }); res.end("<!doctype html>"); }).listen(0, "127.0.0.1");
+await new Promise((r) => server.once("listening", r));
+const gpuRss = () => { try { return Math.max(0, ...execSync("ps -eo rss,args | grep type=gpu-process | grep -v grep | awk '{print $1}'").toString().split("\n").filter(Boolean).map(Number)); } catch { return 0; } };
+const files = (await readdir(root)).filter((f) => f.endsWith(".wgsl") && (!only || f.includes(only)));
+for (const f of files) {
+  const browser = await puppeteer.launch({ executablePath: "/usr/bin/chromium", headless: true, protocolTimeout: 300_000,
+    args: ["--no-sandbox", "--disable-gpu-sandbox", "--enable-unsafe-webgpu", "--use-webgpu-adapter=swiftshader"] });
+  let peak = 0; const timer = setInterval(() => { peak = Math.max(peak, gpuRss()); }, 250);
+  try {
+    const page = await browser.newPage();
+    await page.goto(`http://127.0.0.1:${server.address().port}/`);
+    const code = await readFile(root + f, "utf8");
+    const name = f.replace(".wgsl", "");
+    const r = await page.evaluate(async (code, name) => {
+      const a = await navigator.gpu.requestAdapter(); const d = await a.requestDevice({ requiredLimits: { maxStorageBuffersPerShaderStage: a.limits.maxStorageBuffersPerShaderStage } });
+      let lost = null; d.lost.then((i) => { lost = i.message; });
+      const t0 = performance.now();
+      try {
+        const m = d.createShaderModule({ code });
+        await d.createComputePipelineAsync({ layout: "auto", compute: { module: m, entryPoint: name } });
+        return { ms: performance.now() - t0, lost };
+      } catch (e) { return { ms: performance.now() - t0, error: String(e), lost }; }
+    }, code, name);
+    clearInterval(timer);
+    console.log(`${name}\t${(code.length / 1024).toFixed(0)} KB\t${r.ms.toFixed(0)} ms\tpeak ${(peak / 1024).toFixed(0)} MiB\t${r.error ?? ""}\t${r.lost ?? ""}`);
+  } catch (e) { clearInterval(timer); console.log(`${f}\tfailed: ${e}\tpeak ${(peak / 1024).toFixed(0)} MiB`); }
+  finally { await browser.close(); }
+}
+server.close();
