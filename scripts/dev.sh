@@ -224,7 +224,7 @@ case "$cmd" in
         # workspace whose [patch] resolves each sibling to its extracted package, and
         # each is checked there with `-p` (features resolved for that package alone, as
         # its own verification would), so dependencies that agree are compiled once.
-        # `cargo check` finds every error a build of these libraries finds (they are
+        # `cargo check` runs every compile-time check but code generation (these are
         # rlibs: nothing links until the doc test, which builds the library for real).
         # On two fresh clones side by side (2 cores), this step took 184 s against 213 s
         # for `cargo build` with debug info (issue 32).

@@ -42,7 +42,7 @@ impl CubeReader {
             })
             .collect();
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &entries });
-        let pipeline = kernel_pipeline(device, &super::shader_module(device, k), k, &layout);
+        let pipeline = kernel_pipeline(device, k, &layout);
         // Nearest in every direction: the texel at the sampled point, at the exact level.
         let sampler = device.create_sampler(&wgpu::SamplerDescriptor { label: Some("splitsum cube reader"), ..Default::default() });
         Self { pipeline, layout, sampler }

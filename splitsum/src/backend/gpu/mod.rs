@@ -249,8 +249,7 @@ impl Gpu {
         let build = |k: &EntryPoint| {
             let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
-            let module = shader_module(device, k);
-            let pipeline = kernel_pipeline(device, &module, k, &layout);
+            let pipeline = kernel_pipeline(device, k, &layout);
             (pipeline, layout, scope)
         };
         let mut pipelines = HashMap::new();
@@ -318,7 +317,7 @@ impl Gpu {
         }
         let scope = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let layout = self.device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &group_layout(&[k], 0) });
-        let pipeline = kernel_pipeline(&self.device, &shader_module(&self.device, k), k, &layout);
+        let pipeline = kernel_pipeline(&self.device, k, &layout);
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(Error::gpu_caused(format!("kernel {} did not validate on {}", k.name, self.info.name), e.to_string()));
         }
@@ -495,12 +494,14 @@ fn check_limits(info: &wgpu::AdapterInfo, l: &wgpu::Limits) -> Result<()> {
 }
 
 /// The shader module of entry point `e` (its own module, holding only what it calls).
-pub fn shader_module(device: &wgpu::Device, e: &EntryPoint) -> wgpu::ShaderModule {
+fn shader_module(device: &wgpu::Device, e: &EntryPoint) -> wgpu::ShaderModule {
     device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(e.name), source: wgpu::ShaderSource::SpirV(Cow::Borrowed(e.words())) })
 }
 
-/// The compute pipeline of kernel `k` of `module`, with the bind group layout `layout`.
-fn kernel_pipeline(device: &wgpu::Device, module: &wgpu::ShaderModule, k: &EntryPoint, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
+/// The compute pipeline of kernel `k`, from its own module, with the bind group layout
+/// `layout`.
+fn kernel_pipeline(device: &wgpu::Device, k: &EntryPoint, layout: &wgpu::BindGroupLayout) -> wgpu::ComputePipeline {
+    let module = &shader_module(device, k);
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(k.name), bind_group_layouts: &[Some(layout)], immediate_size: 0 });
     device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
         label: Some(k.name),
