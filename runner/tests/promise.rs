@@ -84,10 +84,16 @@ fn manifest_json(folder: &Path) -> serde_json::Value {
         .unwrap_or_else(|| serde_json::json!({ "format": "splitsum-output-1", "entries": [] }))
 }
 
+/// Adds `entries` to the folder's manifest. A manifest that is there but unreadable (cut,
+/// huge) stays as it is: rewriting it whole would mend the folder, and the model (a forged
+/// folder stays refused) would no longer hold.
 fn add_entries(folder: &Path, entries: Vec<serde_json::Value>) {
+    let p = folder.join(MANIFEST);
+    if std::fs::read(&p).is_ok_and(|b| serde_json::from_slice::<serde_json::Value>(&b).is_err()) {
+        return;
+    }
     let mut m = manifest_json(folder);
     m["entries"].as_array_mut().unwrap().extend(entries);
-    let p = folder.join(MANIFEST);
     let _ = std::fs::remove_file(&p);
     std::fs::write(p, serde_json::to_vec(&m).unwrap()).unwrap();
 }
