@@ -108,7 +108,16 @@ fn tamper(folder: &Path, root: &Path, how: Tampering) -> bool {
     let outside_bytes = std::fs::read(&outside_file).unwrap();
     let rel_to_root = if folder.parent() == Some(root) { "..".to_string() } else { "../..".to_string() };
     let m = manifest_json(folder);
-    let first_file = m["entries"].as_array().unwrap().iter().find(|e| e.get("file").is_some()).and_then(|e| e["path"].as_str()).map(str::to_string);
+    // The first listed file that is there: a listed entry that is not there (the bogus one
+    // below) guards nothing, and listed again as a folder it would mend the folder.
+    let first_file = m["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e.get("file").is_some())
+        .filter_map(|e| e["path"].as_str())
+        .find(|p| !p.starts_with('/') && !p.contains("..") && folder.join(p).is_file())
+        .map(str::to_string);
     let free = |stem: &str| (0..).map(|k| format!("{stem}{k}")).find(|n| std::fs::symlink_metadata(folder.join(n)).is_err()).unwrap();
     match how {
         Tampering::DotDot => add_entries(folder, vec![serde_json::json!({ "path": format!("{rel_to_root}/victim.txt"), "file": stamp(&victim_bytes) })]),
