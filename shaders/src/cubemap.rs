@@ -246,17 +246,32 @@ pub fn edge_texel(face: u32, edge: u32, t: u32, s: u32) -> (u32, u32, u32) {
     (entry & 7, pick((entry >> 3) & 3), pick((entry >> 5) & 3))
 }
 
-/// One weighted bilinear tap: the texel's value times `w`, and `w`; nothing for a tap off
-/// the face in both axes.
-#[inline(always)]
-fn tap(texels: &[Vec4], layout: CubeLayout, level: u32, face: u32, s: u32, x: i32, y: i32, w: f32) -> (Vec4, f32) {
+/// [`tap_texel`] of a tap that is dropped.
+pub const NO_TAP: u32 = u32::MAX;
+
+/// The buffer index of bilinear tap `(x, y)` of `face` of an `s`-wide level `level`, where
+/// `x` or `y` may be one texel off the face ([`tap_index`]); [`NO_TAP`] for a tap off the
+/// face in both axes (a cube corner), which a lookup drops, weight and all.
+///
+/// It takes no buffer, so rust-gpu keeps it a function that every tap of every lookup
+/// calls (a buffer argument forces inlining): with the face wrap inlined at each tap, the
+/// display's fragment shader was 2.3 MB of WGSL, and a browser's compiler (Chromium's
+/// SwiftShader) ran out of memory on any kernel that held two lookups in one loop.
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
+pub fn tap_texel(layout: CubeLayout, level: u32, face: u32, s: u32, x: i32, y: i32) -> u32 {
     let si = s as i32;
     let x_in = x >= 0 && x < si;
     let y_in = y >= 0 && y < si;
-    if x_in || y_in { (texels[tap_index(layout, level, face, x, y, s) as usize] * w, w) } else { (Vec4::ZERO, 0.0) }
+    if x_in || y_in { tap_index(layout, level, face, x, y, s) } else { NO_TAP }
 }
 
 /// Seamless bilinear lookup of level `level` in direction `d` (need not be unit length).
+///
+/// The four taps run as a loop around one [`tap_texel`] call, so that the face wrap is
+/// emitted once per lookup. The sums start at −0, the identity of IEEE addition, so they
+/// equal the unrolled `a + b + c + d` bit for bit.
+#[inline]
 pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3) -> Vec4 {
     let s = layout.level_size(level);
     let (face, uv) = dir_to_face_uv(d);
@@ -269,14 +284,19 @@ pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3)
     let ty = fy - y0f;
     let x0 = x0f as i32;
     let y0 = y0f as i32;
-    // The four taps, unrolled; one that is off the face in both axes (a cube corner) is
-    // dropped, weight and all.
-    let (a, wa) = tap(texels, layout, level, face, s, x0, y0, (1.0 - tx) * (1.0 - ty));
-    let (b, wb) = tap(texels, layout, level, face, s, x0 + 1, y0, tx * (1.0 - ty));
-    let (c, wc) = tap(texels, layout, level, face, s, x0, y0 + 1, (1.0 - tx) * ty);
-    let (e, we) = tap(texels, layout, level, face, s, x0 + 1, y0 + 1, tx * ty);
-    let acc = a + b + c + e;
-    let wsum = wa + wb + wc + we;
+    let mut acc = Vec4::splat(-0.0);
+    let mut wsum = -0.0;
+    let mut k = 0u32;
+    while k < 4 {
+        let (dx, dy) = ((k & 1) as i32, (k >> 1) as i32);
+        let w = (if dx == 1 { tx } else { 1.0 - tx }) * (if dy == 1 { ty } else { 1.0 - ty });
+        let i = tap_texel(layout, level, face, s, x0 + dx, y0 + dy);
+        // A dropped tap is not read: an infinite texel times a zero weight would be NaN.
+        let (v, w) = if i != NO_TAP { (texels[i as usize] * w, w) } else { (Vec4::ZERO, 0.0) };
+        acc += v;
+        wsum += w;
+        k += 1;
+    }
     math::finite4(acc * (1.0 / wsum))
 }
 
@@ -298,9 +318,11 @@ pub fn sample_lod_log(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) ->
 }
 
 /// The bilinear samples of the two levels around `lod` (clamped to the stored levels),
-/// blended linearly, or in log luminance where `log`.
+/// blended linearly ([`sample_lod`]), or in log luminance where `log` ([`sample_lod_log`]).
+/// A caller that chooses at run time calls this once with the choice rather than both:
+/// each call is a lookup the GPU compiler emits again.
 #[inline]
-fn sample_levels(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32, log: bool) -> Vec4 {
+pub fn sample_levels(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32, log: bool) -> Vec4 {
     let max_lod = (layout.levels - 1) as f32;
     let l = math::clamp(lod, 0.0, max_lod);
     let l0 = math::floor(l);

@@ -92,7 +92,8 @@ pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
 ///
 /// The reduction `t − ⌊t + ½⌋` and the quarter-turn split are exact in binary floating
 /// point (Sterbenz), so only the polynomial rounds.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn sin_cos_turns(t: f32) -> (f32, f32) {
     let r = t - floor(t + 0.5); // r ∈ [−½, ½], exact
     let q = floor(r * 4.0 + 0.5); // quadrant ∈ {−2, …, 2}
@@ -115,7 +116,8 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
 }
 
 /// Four-quadrant arctangent of `y/x` in radians, in [−π, π]; `atan2(0, 0) = 0`.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn atan2(y: f32, x: f32) -> f32 {
     let ax = abs(x);
     let ay = abs(y);
@@ -145,7 +147,8 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 
 /// 2^x, exact at integers; `0` below the subnormal range. For `x ≥ 128` it saturates to
 /// [`LARGEST`] rather than overflowing (and naga rejects infinite constants in shaders).
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn exp2(x: f32) -> f32 {
     if x >= 128.0 {
         return LARGEST;
@@ -170,7 +173,8 @@ pub fn exp2(x: f32) -> f32 {
 /// log₂ x for `x > 0`, subnormals included. Outside that domain it saturates instead of
 /// returning ±∞ or NaN (naga rejects such constants in shaders): `x ≤ 0` and NaN give
 /// [`LOG2_FLOOR`], `x = +∞` gives 128.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn log2(x: f32) -> f32 {
     if !(x > 0.0) {
         return LOG2_FLOOR;
@@ -354,10 +358,14 @@ impl<T: Summand> Compensated<T> {
 /// at most this many terms, one dispatch each, carrying their compensated partial sums
 /// between dispatches. Mesa's llvmpipe/lavapipe stops *all* loops of an invocation after
 /// 65 535 iterations in total (`LP_MAX_TGSI_LOOP_ITERATIONS`, "shared between every loop
-/// in a shader"); without chunks a 1024-sample prefilter came out as NaN there. A multiple
+/// in a shader"); without chunks a 1024-sample prefilter came out as NaN there. Each
+/// sample of a prefilter is a trilinear lookup, two bilinear ones of four taps each run as
+/// a loop (`cubemap::sample_bilinear`, so that a browser's compiler sees each tap once):
+/// at most 1 + 2·(1 + 4) = 11 iterations per sample, each loop entered counting, so a
+/// chunk of 4096 samples stays under the budget (45 056) where 16 384 did not. A multiple
 /// of `SUM_BLOCK`, so chunk boundaries fall on block boundaries and chunked sums are the
 /// same arithmetic as one long sum.
-pub const CHUNK: u32 = 16 * SUM_BLOCK;
+pub const CHUNK: u32 = 4 * SUM_BLOCK;
 
 /// The compensated partial sums of a weighted mean `Σ L·w / Σ w`, carried from chunk to
 /// chunk (see [`CHUNK`]): the value sum and its carry, and the weight sum and carry in

@@ -187,7 +187,8 @@ pub fn sampled_dir(lobe: Lobe, src: &[Vec4], layout: CubeLayout, n: Vec3, roughn
 /// 2013, with the filtered importance sampling of Křivánek & Colbert 2008). It depends on
 /// no texel: the GPU computes it per sample, the CPU backend once per level
 /// ([`lobe_samples`]) and reads it back ([`accumulate_samples`]), the same values.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn ggx_sample(i: u32, samples: u32, alpha: f32, src_size: u32, lod_bias: f32) -> Vec4 {
     let ht = sampling::sample_ggx_tangent(sampling::hammersley(i, samples), alpha);
     let pdf = 0.25 * microfacet::d_ggx(ht.z, alpha);
@@ -200,7 +201,8 @@ pub fn ggx_sample(i: u32, samples: u32, alpha: f32, src_size: u32, lod_bias: f32
 /// (`sheen::charlie_light_sample`: every sample above the horizon, all of equal weight),
 /// and its source level. The point is `(radical inverse of i, (i + ½)/N)`: the second
 /// coordinate (stratified, never 0 or 1) for `n·l`, the first for the azimuth.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn charlie_sample(i: u32, samples: u32, alpha: f32, src_size: u32, lod_bias: f32) -> Vec4 {
     let xi = Vec2::new(sampling::radical_inverse(i), (i as f32 + 0.5) / samples as f32);
     let s = sheen::charlie_light_sample(xi, alpha);

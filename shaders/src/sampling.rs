@@ -83,7 +83,8 @@ pub fn sample_ggx(xi: Vec2, alpha: f32, n: Vec3) -> Vec3 {
 /// Density `G₁(v) max(0, v·h) D(h) / v.z`; each sample's reflection `l` has density
 /// `G₁(v) D(h) / (4 v.z)`. `α = 0` gives `(0, 0, 1)`; a point on the disk's rim cannot
 /// give a zero vector (the normalisation falls back to the normal).
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn sample_vndf_tangent(xi: Vec2, alpha: f32, v: Vec3) -> Vec3 {
     let vh = normalize_or(Vec3::new(alpha * v.x, alpha * v.y, v.z), Vec3::Z);
     let len2 = vh.x * vh.x + vh.y * vh.y;

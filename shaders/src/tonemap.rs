@@ -73,7 +73,8 @@ pub fn key_exposure(log_average: f32) -> f32 {
 }
 
 /// Linear radiance to linear display values in [0, 1]: exposure and tone curve.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn tone(c: Vec3, exposure: f32, curve: Tonemapper) -> Vec3 {
     let e = c * exposure;
     match curve {

@@ -49,9 +49,13 @@ pub const MAX_FETCHES: u32 = 1 << (LADDER_RUNGS - 1);
 pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3) -> Vec3 {
     let roughness = m.roughness;
     let fetches = opts.fetches();
+    let ladder = fetches > 1 && opts.specular == SpecularModel::CookTorrance as u32;
+    // The ladder's one fetch reads without filtered sampling. One call either way: each
+    // call is a lookup the GPU compiler emits again.
     let read = opts.flags & !ShadeOptions::FILTERED_SAMPLING;
-    if fetches <= 1 || opts.specular != SpecularModel::CookTorrance as u32 {
-        return one_fetch(shape, specular, opts.flags, n, v, roughness);
+    let one = one_fetch(shape, specular, if ladder { read } else { opts.flags }, n, v, roughness);
+    if !ladder {
+        return one;
     }
     let alpha = alpha_from_roughness(math::saturate(roughness));
     let a2 = alpha * alpha;
@@ -60,7 +64,6 @@ pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOpti
     let vt = sampling::normalize_or(Vec3::new(v.dot(t), v.dot(b), math::max(n.dot(v), MIN_N_DOT_V)), Vec3::Z);
     let view = t * vt.x + b * vt.y + n * vt.z;
     let nv = vt.z;
-    let one = one_fetch(shape, specular, read, n, v, roughness);
     let s = math::saturate((LADDER_FULL_BELOW + LADDER_BLEND - nv) / LADDER_BLEND);
     if !(s > 0.0) {
         return one;
@@ -82,7 +85,7 @@ pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOpti
             let q = ht.z * ht.z * (a2 - 1.0) + 1.0;
             let covered = nv * q * q / (fetches as f32 * g1 * math::max(a2, 1e-12));
             let r = math::min(math::sqrt(math::sqrt(covered)), roughness);
-            sum += w * prefiltered(shape, specular, read, l, r).truncate();
+            sum += w * prefiltered_trilinear(shape, specular, read, l, r).truncate();
             weights += w;
         }
         i += 1;

@@ -373,11 +373,19 @@ pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: 
     let lod = RoughnessMapping::from_u32(shape.mapping).lod(roughness, shape.specular_levels);
     if flags & ShadeOptions::FILTERED_SAMPLING != 0 && lod > 0.0 && lod < 1.0 && shape.specular_levels > 1 {
         filtered_lookup(specular, layout, dir, roughness)
-    } else if flags & ShadeOptions::LOG_MIP_BLEND != 0 {
-        cubemap::sample_lod_log(specular, layout, dir, lod)
     } else {
-        cubemap::sample_lod(specular, layout, dir, lod)
+        prefiltered_trilinear(shape, specular, flags, dir, roughness)
     }
+}
+
+/// [`prefiltered`] without [`ShadeOptions::FILTERED_SAMPLING`] (whatever `flags` say): the
+/// trilinear lookup alone, for callers that never sample (the ladder's fetches), so that
+/// the GPU compiler does not emit the sampled lookup there too.
+#[inline]
+pub fn prefiltered_trilinear(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: Vec3, roughness: f32) -> Vec4 {
+    let layout = CubeLayout::new(shape.specular_size, shape.specular_levels);
+    let lod = RoughnessMapping::from_u32(shape.mapping).lod(roughness, shape.specular_levels);
+    cubemap::sample_levels(specular, layout, dir, lod, flags & ShadeOptions::LOG_MIP_BLEND != 0)
 }
 
 /// The direction the one fetch reads the prefiltered cube along for normal `n` and view
