@@ -117,6 +117,26 @@ ensure_gl() {
     ensure_packages '/usr/lib/*/libEGL.so.1:libegl1' '/usr/lib/*/libEGL_mesa.so.0:libegl-mesa0' '/usr/lib/*/libGLESv2.so.2:libgles2' '/usr/lib/*/dri/swrast_dri.so:libgl1-mesa-dri'
 }
 
+# The library in a browser (tests/webgpu): the wasm32 target, the wasm-bindgen CLI at the
+# version tests/webgpu/Cargo.lock pins (crates.io), the page's crate built for wasm32 and
+# bound, and puppeteer-core (npm). Chromium comes from ensure_browser.
+ensure_webgpu() {
+    dry && return 0
+    rustup target add wasm32-unknown-unknown >&2
+    local want
+    want=$(sed -n '/^name = "wasm-bindgen"$/{n;s/^version = "\(.*\)"/\1/p}' tests/webgpu/Cargo.lock)
+    if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $want" ]; then
+        echo "dev.sh: installing wasm-bindgen-cli $want (crates.io)" >&2
+        cargo +stable install --locked wasm-bindgen-cli --version "$want" >&2
+    fi
+    (
+        cd tests/webgpu
+        cargo +stable build --release --target wasm32-unknown-unknown >&2
+        wasm-bindgen --target web --out-dir pkg target/wasm32-unknown-unknown/release/splitsum_webgpu_check.wasm
+        [ -d node_modules/puppeteer-core ] || npm install --no-audit --no-fund --silent
+    )
+}
+
 # The windowed smoke test opens the viewer on Xvfb and screenshots it with xwd.
 ensure_test_display() {
     ensure_packages '/usr/bin/Xvfb:xvfb' '/usr/bin/xwd:x11-apps'
@@ -204,6 +224,22 @@ case "$cmd" in
             --test-threads=1 \
             prefilter:: lut:: equirect:: irradiance:: stability:: library:: render:: targets:: sheen:: \
             --skip sheen::a_gltf_model_with_sheen_loads_and_renders
+        # The library in headless Chromium's WebGPU (SwiftShader): a bake read back and
+        # compared with the CPU backend (tests/library.rs). With no test filter only.
+        if [ $# -eq 0 ]; then
+            echo "dev.sh: the browser test (wasm32, headless Chromium's WebGPU)" >&2
+            webgpu_start=$SECONDS
+            ensure_webgpu
+            run cargo +stable test --release -p splitsum-tests --test suite library::a_bake_in_the_browsers_webgpu_matches_the_cpu -- --ignored --nocapture
+            echo "dev.sh: the browser test took $((SECONDS - webgpu_start)) s" >&2
+        fi
+        ;;
+    webgpu)
+        # The browser test alone.
+        ensure_stable
+        ensure_browser
+        ensure_webgpu
+        run_last cargo +stable test --release -p splitsum-tests --test suite library::a_bake_in_the_browsers_webgpu_matches_the_cpu -- --ignored --nocapture "$@"
         ;;
     peers)
         ensure_peers
@@ -290,7 +326,7 @@ case "$cmd" in
         dry || spirv_stamp
         ;;
     *)
-        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | table | peers | environments | viewer" >&2
+        echo "usage: bash scripts/dev.sh run [ARGS...] | test [ARGS...] | cargo ARGS... | package | spirv [--check] | table | peers | environments | viewer | webgpu" >&2
         exit 2
         ;;
 esac

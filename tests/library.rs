@@ -313,9 +313,10 @@ fn a_device_that_cannot_run_the_kernels_is_refused_by_name() {
 /// WebGPU device (SwiftShader) through `tests/webgpu` (wasm-bindgen, puppeteer-core), and
 /// the textures it reads back agree with a CPU bake of the same environment within a half
 /// float's step (2⁻¹⁰ relative above 10⁻³ of the peak), as on Vulkan and GL. Needs what
-/// `bash scripts/webgpu.sh` builds and installs (it runs this test); ignored otherwise.
+/// `bash scripts/dev.sh webgpu` builds and installs (it runs this test, and so does
+/// `dev.sh test`); ignored otherwise.
 #[test]
-#[ignore = "needs Chromium and the wasm build: bash scripts/webgpu.sh"]
+#[ignore = "needs Chromium and the wasm build: bash scripts/dev.sh webgpu"]
 fn a_bake_in_the_browsers_webgpu_matches_the_cpu() {
     let (w, h, size) = (64u32, 32u32, 16u32);
     let mut texels = Vec::new();

@@ -1,4 +1,4 @@
-//! The page side of `scripts/webgpu.sh`: splitsum baking on the browser's WebGPU device.
+//! The page side of `bash scripts/dev.sh webgpu` (and of `dev.sh test`): splitsum baking on the browser's WebGPU device.
 
 use splitsum::glam::Vec4;
 use splitsum::texture::Equirect;
