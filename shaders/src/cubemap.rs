@@ -250,7 +250,7 @@ pub fn edge_texel(face: u32, edge: u32, t: u32, s: u32) -> (u32, u32, u32) {
 pub const NO_TAP: u32 = u32::MAX;
 
 /// The buffer index of bilinear tap `(x, y)` of `face` of an `s`-wide level `level`, where
-/// `x` or `y` may be one texel off the face ([`tap_index`]); [`NO_TAP`] for a tap off the
+/// `x` or `y` may be one texel off the face (`tap_index`); [`NO_TAP`] for a tap off the
 /// face in both axes (a cube corner), which a lookup drops, weight and all.
 ///
 /// It takes no buffer, so rust-gpu keeps it a function that every tap of every lookup

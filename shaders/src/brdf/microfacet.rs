@@ -15,7 +15,8 @@ use spirv_std::glam::Vec3;
 /// Evaluated as `(α / ((1 − (n·h)²) + (n·h·α)²))² / π` with `1 − (n·h)² = (1−n·h)(1+n·h)`
 /// (Filament, "Physically Based Rendering in Filament", §4.4.1): the same value, but with
 /// no catastrophic cancellation near the peak and no underflow of `α⁴` for tiny `α`.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn d_ggx(n_dot_h: f32, alpha: f32) -> f32 {
     let nh = math::saturate(n_dot_h);
     let one_minus_nh2 = (1.0 - nh) * (1.0 + nh);
@@ -93,7 +94,8 @@ pub enum Masking {
 /// `V = ½ / ((n·l)√((n·v)²(1−α²) + α²) + (n·v)√((n·l)²(1−α²) + α²))`
 /// (Filament, "Physically Based Rendering in Filament", §4.4.2): finite at grazing angles
 /// whenever `α > 0`.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn vis_smith_correlated(n_dot_v: f32, n_dot_l: f32, alpha: f32) -> f32 {
     let nv = math::saturate(n_dot_v);
     let nl = math::saturate(n_dot_l);

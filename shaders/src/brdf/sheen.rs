@@ -40,7 +40,8 @@ pub fn alpha(roughness: f32) -> f32 {
 
 /// The Charlie distribution `D(h)` at `n·h` for width `α` (Estevez & Kulla 2017, eq. 2).
 /// `sin²θ` is clamped at 0 against rounding (`n·h` a hair above 1).
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn d_charlie(n_dot_h: f32, alpha: f32) -> f32 {
     let inv = 1.0 / alpha;
     let sin2 = math::max(1.0 - n_dot_h * n_dot_h, 0.0);
@@ -65,7 +66,8 @@ fn l_fit(x: f32, alpha: f32) -> f32 {
 /// The Charlie masking `Λ(θ)` at `cos θ` for width `α`: `exp(L(cos θ))` below `cos θ = ½`,
 /// `exp(2L(½) − L(1 − cos θ))` above (Estevez & Kulla 2017, §3: the fit is made on the
 /// grazing half and mirrored, which keeps `Λ` smooth at ½).
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn lambda_charlie(cos_theta: f32, alpha: f32) -> f32 {
     let c = math::saturate(math::abs(cos_theta));
     if c < 0.5 { math::exp2(l_fit(c, alpha) * core::f32::consts::LOG2_E) } else { math::exp2((2.0 * l_fit(0.5, alpha) - l_fit(1.0 - c, alpha)) * core::f32::consts::LOG2_E) }
@@ -74,7 +76,8 @@ pub fn lambda_charlie(cos_theta: f32, alpha: f32) -> f32 {
 /// The Charlie visibility `V = 1/((1 + Λ(v) + Λ(l))·4(n·l)(n·v))` (Estevez & Kulla 2017,
 /// §3, with the height-correlated form `G = 1/(1 + Λ(v) + Λ(l))`), clamped to [0, 1] as the
 /// glTF Sample Viewer's `V_Sheen` clamps it. Zero where either cosine is not positive.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn v_charlie(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
     if !(n_dot_l > 0.0 && n_dot_v > 0.0) {
         return 0.0;
@@ -137,7 +140,8 @@ pub fn sample_charlie_tangent(xi: Vec2, alpha: f32) -> Vec3 {
 /// **Exact sums** weigh each texel by `D(h)·(n·l)·Ω` with `D` scaled by its largest value
 /// on the hemisphere, `(1 − n·l)^k` ([`charlie_light_weight`]): no underflow at `n·l = 0`
 /// however small `α`.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn charlie_light_sample(xi: Vec2, alpha: f32) -> Vec4 {
     let b = 1.0 + 0.5 / alpha;
     // −ln ξ, ξ ∈ (0, 1).
@@ -175,7 +179,8 @@ fn charlie_c(y: f32, b: f32) -> (f32, f32) {
 
 /// `D(h)` of the light direction at `n·l` (with `v = n`), divided by its largest value over
 /// `n·l ≥ 0`: `(1 − n·l)^(1/(2α))`, the exact sums' weight before `n·l·Ω`.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn charlie_light_weight(n_dot_l: f32, alpha: f32) -> f32 {
     math::pow(math::saturate(1.0 - n_dot_l), 0.5 / alpha)
 }

@@ -48,15 +48,9 @@ pub const MAX_FETCHES: u32 = 1 << (LADDER_RUNGS - 1);
 #[inline]
 pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3) -> Vec3 {
     let roughness = m.roughness;
-    let fetches = opts.fetches();
-    let ladder = fetches > 1 && opts.specular == SpecularModel::CookTorrance as u32;
-    // The ladder's one fetch reads without filtered sampling. One call either way: each
-    // call is a lookup the GPU compiler emits again.
-    let read = opts.flags & !ShadeOptions::FILTERED_SAMPLING;
-    let one = one_fetch(shape, specular, if ladder { read } else { opts.flags }, n, v, roughness);
-    if !ladder {
-        return one;
-    }
+    let ladder = opts.fetches() > 1 && opts.specular == SpecularModel::CookTorrance as u32;
+    // The ladder reads without filtered sampling, its one fetch included.
+    let read = if ladder { opts.flags & !ShadeOptions::FILTERED_SAMPLING } else { opts.flags };
     let alpha = alpha_from_roughness(math::saturate(roughness));
     let a2 = alpha * alpha;
     let (t, b) = sampling::orthonormal_basis(n);
@@ -65,32 +59,48 @@ pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOpti
     let view = t * vt.x + b * vt.y + n * vt.z;
     let nv = vt.z;
     let s = math::saturate((LADDER_FULL_BELOW + LADDER_BLEND - nv) / LADDER_BLEND);
-    if !(s > 0.0) {
-        return one;
-    }
+    let fetches = if ladder && s > 0.0 { opts.fetches() } else { 0 };
     let g1 = 2.0 * nv / (nv + math::sqrt(nv * nv * (1.0 - a2) + a2));
     let f0 = m.f0();
+    let mut one = Vec3::ZERO;
     let mut sum = Vec3::ZERO;
     let mut weights = Vec3::ZERO;
-    let mut i = 0;
-    while i < fetches {
-        let turn = 0.25 + i as f32 * GOLDEN;
-        let xi = Vec2::new((i as f32 + 0.5) / fetches as f32, turn - math::floor(turn));
-        let ht = sampling::sample_vndf_tangent(xi, alpha, vt);
-        let h = t * ht.x + b * ht.y + n * ht.z;
-        let l = sampling::reflect(view, h);
-        let nl = n.dot(l);
-        if nl > 0.0 {
-            let w = fresnel(opts.fresnel, f0, math::saturate(view.dot(h))) * (microfacet::vis_smith_correlated(nv, nl, alpha) * nl);
-            let q = ht.z * ht.z * (a2 - 1.0) + 1.0;
-            let covered = nv * q * q / (fetches as f32 * g1 * math::max(a2, 1e-12));
-            let r = math::min(math::sqrt(math::sqrt(covered)), roughness);
-            sum += w * prefiltered_trilinear(shape, specular, read, l, r).truncate();
-            weights += w;
+    // Fetch 0 is the split sum's one fetch; fetches 1 to K follow the lobe. One loop around
+    // one lookup: each lookup written out is one the GPU compiler emits again.
+    let mut k = 0;
+    while k <= fetches {
+        let (dir, r, w, read_it) = if k == 0 {
+            (read_direction(read, n, v, roughness), roughness, Vec3::ONE, true)
+        } else {
+            let i = k - 1;
+            let turn = 0.25 + i as f32 * GOLDEN;
+            let xi = Vec2::new((i as f32 + 0.5) / fetches as f32, turn - math::floor(turn));
+            let ht = sampling::sample_vndf_tangent(xi, alpha, vt);
+            let h = t * ht.x + b * ht.y + n * ht.z;
+            let l = sampling::reflect(view, h);
+            let nl = n.dot(l);
+            if nl > 0.0 {
+                let w = fresnel(opts.fresnel, f0, math::saturate(view.dot(h))) * (microfacet::vis_smith_correlated(nv, nl, alpha) * nl);
+                let q = ht.z * ht.z * (a2 - 1.0) + 1.0;
+                let covered = nv * q * q / (fetches as f32 * g1 * math::max(a2, 1e-12));
+                (l, math::min(math::sqrt(math::sqrt(covered)), roughness), w, true)
+            } else {
+                // Below the horizon: weighs nothing, and is not read.
+                (l, roughness, Vec3::ZERO, false)
+            }
+        };
+        if read_it {
+            let value = prefiltered(shape, specular, read, dir, r).truncate();
+            if k == 0 {
+                one = value;
+            } else {
+                sum += w * value;
+                weights += w;
+            }
         }
-        i += 1;
+        k += 1;
     }
-    if !(weights.x > 0.0 && weights.y > 0.0 && weights.z > 0.0) {
+    if fetches == 0 || !(weights.x > 0.0 && weights.y > 0.0 && weights.z > 0.0) {
         return one;
     }
     one + (sum / weights - one) * s
@@ -102,8 +112,3 @@ pub const LADDER_FULL_BELOW: f32 = 0.4;
 /// Width in `n·v` of the ladder's blend into the one fetch.
 pub const LADDER_BLEND: f32 = 0.3;
 
-/// The split sum's one fetch: the prefiltered radiance along the read direction.
-#[inline]
-fn one_fetch(shape: EnvironmentShape, specular: &[Vec4], flags: u32, n: Vec3, v: Vec3, roughness: f32) -> Vec3 {
-    prefiltered(shape, specular, flags, read_direction(flags, n, v, roughness), roughness).truncate()
-}

@@ -223,13 +223,15 @@ impl Material {
 }
 
 /// Fresnel at `cos_theta` in the chosen form.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn fresnel(form: u32, f0: Vec3, cos_theta: f32) -> Vec3 {
     if form == FresnelForm::SphericalGaussian as u32 { fresnel::spherical_gaussian3(f0, cos_theta) } else { fresnel::schlick3(f0, cos_theta) }
 }
 
 /// The roughness-aware Fresnel of the ambient term in the chosen form.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn fresnel_ambient(form: u32, f0: Vec3, n_dot_v: f32, roughness: f32) -> Vec3 {
     if form == FresnelForm::SphericalGaussian as u32 {
         let g = Vec3::splat(1.0 - roughness).max(f0);
@@ -332,7 +334,8 @@ pub struct EnvironmentShape {
 /// leans from the mirror direction towards the normal as roughness grows; `n = v = r`
 /// ignores that, and this fitted lerp restores most of it at the cost of one lerp and one
 /// normalisation per pixel.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn specular_direction(flags: u32, n: Vec3, r: Vec3, roughness: f32) -> Vec3 {
     if flags & ShadeOptions::DOMINANT_DIRECTION != 0 { dominant_direction(n, r, roughness) } else { r }
 }
@@ -374,18 +377,8 @@ pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: 
     if flags & ShadeOptions::FILTERED_SAMPLING != 0 && lod > 0.0 && lod < 1.0 && shape.specular_levels > 1 {
         filtered_lookup(specular, layout, dir, roughness)
     } else {
-        prefiltered_trilinear(shape, specular, flags, dir, roughness)
+        cubemap::sample_levels(specular, layout, dir, lod, flags & ShadeOptions::LOG_MIP_BLEND != 0)
     }
-}
-
-/// [`prefiltered`] without [`ShadeOptions::FILTERED_SAMPLING`] (whatever `flags` say): the
-/// trilinear lookup alone, for callers that never sample (the ladder's fetches), so that
-/// the GPU compiler does not emit the sampled lookup there too.
-#[inline]
-pub fn prefiltered_trilinear(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: Vec3, roughness: f32) -> Vec4 {
-    let layout = CubeLayout::new(shape.specular_size, shape.specular_levels);
-    let lod = RoughnessMapping::from_u32(shape.mapping).lod(roughness, shape.specular_levels);
-    cubemap::sample_levels(specular, layout, dir, lod, flags & ShadeOptions::LOG_MIP_BLEND != 0)
 }
 
 /// The direction the one fetch reads the prefiltered cube along for normal `n` and view
@@ -421,7 +414,8 @@ pub const HORIZON_LIFT: f32 = 0.75;
 /// direction lower than `θ` above the horizon is turned up, in the plane of `n` and `d`, to
 /// `θ`; one higher is left as it is, and `k ≥ 1` (a lobe of a hemisphere) reads along `n`.
 /// Turning the direction instead of darkening the read keeps a constant environment exact.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn above_horizon(n: Vec3, d: Vec3, roughness: f32) -> Vec3 {
     let k = HORIZON_LIFT * alpha_from_roughness(math::saturate(roughness));
     if k >= 1.0 {
@@ -497,7 +491,8 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
 ///   irradiance: `L_o = (F·A + B)·L̃ + F_ms·E_ms·E/π`.
 ///
 /// Under a white furnace (`L̃ = E/π = 1`) a metal with `F₀ = 1` then reflects exactly 1.
-#[inline]
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn multiple_scattering(f: Vec3, f0: Vec3, brdf: Vec2) -> (Vec3, Vec3) {
     let single = f * brdf.x + Vec3::splat(brdf.y);
     let e_ms = math::saturate(1.0 - brdf.x - brdf.y);
