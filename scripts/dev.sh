@@ -126,8 +126,10 @@ ensure_webgpu() {
     local want
     want=$(sed -n '/^name = "wasm-bindgen"$/{n;s/^version = "\(.*\)"/\1/p}' tests/webgpu/Cargo.lock)
     if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $want" ]; then
+        # Not --locked: its lock pins crates (webpki-roots 1.0.11) this registry lacks.
+        # About 2 minutes on two cores.
         echo "dev.sh: installing wasm-bindgen-cli $want (crates.io)" >&2
-        cargo +stable install --locked wasm-bindgen-cli --version "$want" >&2
+        cargo +stable install --force wasm-bindgen-cli --version "$want" >&2
     fi
     (
         cd tests/webgpu
