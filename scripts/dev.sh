@@ -139,6 +139,9 @@ ensure_webgpu() {
     )
 }
 
+# The browser test: run by `test` (with no filter) and by `webgpu`.
+WEBGPU_TEST=(cargo +stable test --release -p splitsum-tests --test suite library::a_bake_in_the_browsers_webgpu_matches_the_cpu -- --ignored --nocapture)
+
 # The windowed smoke test opens the viewer on Xvfb and screenshots it with xwd.
 ensure_test_display() {
     ensure_packages '/usr/bin/Xvfb:xvfb' '/usr/bin/xwd:x11-apps'
@@ -232,7 +235,7 @@ case "$cmd" in
             echo "dev.sh: the browser test (wasm32, headless Chromium's WebGPU)" >&2
             webgpu_start=$SECONDS
             ensure_webgpu
-            run cargo +stable test --release -p splitsum-tests --test suite library::a_bake_in_the_browsers_webgpu_matches_the_cpu -- --ignored --nocapture
+            run "${WEBGPU_TEST[@]}"
             echo "dev.sh: the browser test took $((SECONDS - webgpu_start)) s" >&2
         fi
         ;;
@@ -241,7 +244,7 @@ case "$cmd" in
         ensure_stable
         ensure_browser
         ensure_webgpu
-        run_last cargo +stable test --release -p splitsum-tests --test suite library::a_bake_in_the_browsers_webgpu_matches_the_cpu -- --ignored --nocapture "$@"
+        run_last "${WEBGPU_TEST[@]}" "$@"
         ;;
     peers)
         ensure_peers

@@ -11,14 +11,13 @@
 // the device's loss message if any.
 import { createServer } from "node:http";
 import { readFile, readdir } from "node:fs/promises";
-import { execSync } from "node:child_process";
 import puppeteer from "puppeteer-core";
+import { sampleGpuPeak } from "./gpu-memory.mjs";
 const [dir, only] = process.argv.slice(2);
 const root = dir.endsWith("/") ? dir : dir + "/";
 // An empty page on loopback (a secure context, where WebGPU is offered).
 const server = createServer((req, res) => { res.writeHead(200, { "content-type": "text/html" }); res.end("<!doctype html>"); }).listen(0, "127.0.0.1");
 await new Promise((r) => server.once("listening", r));
-const gpuRss = () => { try { return Math.max(0, ...execSync("ps -eo rss,args | grep type=gpu-process | grep -v grep | awk '{print $1}'").toString().split("\n").filter(Boolean).map(Number)); } catch { return 0; } };
 // A fragment shader is built with the vertex shader its pipeline uses (display/src/render):
 // the full-screen triangle for the scene, the mesh's (position, normal, tangent, uv) for
 // meshes. Vertex shaders are not built alone.
@@ -27,7 +26,7 @@ const files = (await readdir(root)).filter((f) => f.endsWith(".wgsl") && !f.ends
 for (const f of files) {
   const browser = await puppeteer.launch({ executablePath: "/usr/bin/chromium", headless: true, protocolTimeout: 300_000,
     args: ["--no-sandbox", "--disable-gpu-sandbox", "--enable-unsafe-webgpu", "--use-webgpu-adapter=swiftshader"] });
-  let peak = 0; const timer = setInterval(() => { peak = Math.max(peak, gpuRss()); }, 250);
+  const sampler = sampleGpuPeak(browser);
   try {
     const page = await browser.newPage();
     await page.goto(`http://127.0.0.1:${server.address().port}/`);
@@ -57,9 +56,9 @@ for (const f of files) {
         return { ms: performance.now() - t0, lost };
       } catch (e) { return { ms: performance.now() - t0, error: String(e), lost }; }
     }, code, name, vs, vcode);
-    clearInterval(timer);
-    console.log(`${name}\t${(code.length / 1024).toFixed(0)} KB\t${r.ms.toFixed(0)} ms\tpeak ${(peak / 1024).toFixed(0)} MiB\t${r.error ?? ""}\t${r.lost ?? ""}`);
-  } catch (e) { clearInterval(timer); console.log(`${f}\tfailed: ${e}\tpeak ${(peak / 1024).toFixed(0)} MiB`); }
+    const peak = sampler.stop();
+    console.log(`${name}\t${(code.length / 1024).toFixed(0)} KB\t${r.ms.toFixed(0)} ms\tpeak ${(peak / 2 ** 20).toFixed(0)} MiB\t${r.error ?? ""}\t${r.lost ?? ""}`);
+  } catch (e) { console.log(`${f}\tfailed: ${e}\tpeak ${(sampler.stop() / 2 ** 20).toFixed(0)} MiB`); }
   finally { await browser.close(); }
 }
 server.close();

@@ -5,8 +5,8 @@
 import { createServer } from "node:http";
 import { readFile, writeFile } from "node:fs/promises";
 import { extname, join } from "node:path";
-import { execSync } from "node:child_process";
 import puppeteer from "puppeteer-core";
+import { sampleGpuPeak } from "./gpu-memory.mjs";
 
 const [input, output] = process.argv.slice(2);
 const root = new URL(".", import.meta.url).pathname;
@@ -30,10 +30,8 @@ const browser = await puppeteer.launch({
   args: ["--no-sandbox", "--disable-gpu-sandbox", "--enable-unsafe-webgpu", "--use-webgpu-adapter=swiftshader", "--disable-background-networking",
          "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"],
 });
-// The GPU process's resident memory, sampled every 250 ms: its peak goes in OUTPUT.txt.
-const gpuRss = () => { try { return Math.max(0, ...execSync("ps -eo rss,args | grep type=gpu-process | grep -v grep | awk '{print $1}'").toString().split("\n").filter(Boolean).map(Number)); } catch { return 0; } };
-let peak = 0;
-const sampler = setInterval(() => { peak = Math.max(peak, gpuRss()); }, 250);
+// The GPU process's peak resident memory goes in OUTPUT.txt and OUTPUT.peak (bytes).
+const sampler = sampleGpuPeak(browser);
 try {
   const page = await browser.newPage();
   page.on("console", (m) => console.error("page:", m.text()));
@@ -57,15 +55,15 @@ try {
     await writeFile(output + ".err", result.error);
     console.error("error:", result.error);
   } else {
-    peak = Math.max(peak, gpuRss());
-    const said = `bake and readback ${result.ms.toFixed(0)} ms in headless Chromium (SwiftShader), GPU process peak ${(peak / 1024).toFixed(0)} MiB`;
+    const peak = sampler.stop();
+    const said = `bake and readback ${result.ms.toFixed(0)} ms in headless Chromium (SwiftShader), GPU process peak ${(peak / 2 ** 20).toFixed(0)} MiB`;
     console.error(said);
     await writeFile(output, Buffer.from(new Float32Array(result.out).buffer));
     await writeFile(output + ".txt", said + "\n");
-    await writeFile(output + ".peak", String(peak * 1024));
+    await writeFile(output + ".peak", String(peak));
   }
 } finally {
-  clearInterval(sampler);
+  sampler.stop();
   await browser.close();
   server.close();
 }
