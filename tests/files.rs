@@ -184,6 +184,28 @@ fn radiance_hdr_files_load() {
     assert!((e.texels[100].x - 10.0).abs() < 10.0 / 128.0, "{}", e.texels[100]);
 }
 
+/// A file held in memory (what a web page is given) reads as the same file read from disk:
+/// the same texels, the same report, the same errors.
+#[test]
+fn files_in_memory_read_as_files_on_disk() {
+    let d = scratch("bytes");
+    let hdr = d.join("sky.hdr");
+    let (w, h) = (64u32, 32u32);
+    let pixels: Vec<image::Rgb<f32>> = (0..w * h).map(|i| image::Rgb([i as f32 / 10.0, 1.0, 2.0])).collect();
+    image::codecs::hdr::HdrEncoder::new(std::fs::File::create(&hdr).unwrap()).encode(&pixels, w as usize, h as usize).unwrap();
+    let exr = Path::new(env!("CARGO_MANIFEST_DIR")).join("../splitsum/assets/courtyard.exr");
+    for p in [hdr, exr] {
+        let (disk, disk_report) = environment::load(&p, false).unwrap();
+        let (memory, memory_report) = environment::read_bytes("dropped", &std::fs::read(&p).unwrap(), false).unwrap();
+        let (Environment::Equirect(a), Environment::Equirect(b)) = (disk, memory) else { panic!("equirects") };
+        assert_eq!((a.width, a.height), (b.width, b.height), "{}", p.display());
+        assert!(a.texels == b.texels, "{}: texels differ", p.display());
+        assert_eq!(format!("{disk_report:?}"), format!("{memory_report:?}"));
+    }
+    let e = environment::read_bytes("sky.png", b"\x89PNG....", false).unwrap_err().to_string();
+    assert!(e.contains("sky.png") && e.contains("neither an OpenEXR nor a Radiance HDR"), "{e}");
+}
+
 #[test]
 fn six_face_folders_load_and_are_checked() {
     let d = scratch("faces");
@@ -253,4 +275,38 @@ fn radiance_scanlines_decode_as_the_image_crate_decodes_them() {
     // its mantissas times 2^(140−136).
     assert_eq!(&a[3 * 300..3 * 301], &[10.0 * 16.0, 20.0 * 16.0, 30.0 * 16.0]);
     assert_eq!(&a[3 * 299..3 * 300], &a[0..3]);
+}
+
+/// Every target's files made in memory (the web page's zip) are the bytes `output::write`
+/// puts on disk, under the same names, and nothing else.
+#[test]
+fn a_folder_in_memory_is_the_folder_on_disk() {
+    use splitsum::{Backend, Choice, Settings, Target, output};
+    let (env, _) = environment::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../splitsum/assets/courtyard.exr"), false).unwrap();
+    for target in [Target::Splitsum, Target::Khronos, Target::Bevy, Target::Filament] {
+        let job = Settings { size: 16, ..Settings::default() }.with_target(target).resolve(splitsum::InputShape::of(&env), target.products()).unwrap();
+        let baked = splitsum::bake_job(&Backend::Cpu, &env, &job).unwrap();
+        let dir = scratch(&format!("memory-{}", target.name())).join("sky");
+        output::write(&dir, &baked, &job, output::About::default()).unwrap();
+        let (_, files) = output::in_memory("sky", &baked, &job, output::About::default()).unwrap();
+        let mut on_disk = Vec::new();
+        let mut walk = vec![dir.clone()];
+        while let Some(d) = walk.pop() {
+            for e in std::fs::read_dir(&d).unwrap() {
+                let p = e.unwrap().path();
+                if p.is_dir() {
+                    walk.push(p);
+                } else {
+                    on_disk.push(p.strip_prefix(&dir).unwrap().to_string_lossy().replace('\\', "/"));
+                }
+            }
+        }
+        // The folder's guard (files::OUTPUT_MANIFEST) is the folder's, not the bake's.
+        on_disk.retain(|n| n != splitsum::files::OUTPUT_MANIFEST);
+        on_disk.sort();
+        assert_eq!(files.iter().map(|f| f.0.clone()).collect::<Vec<_>>(), on_disk, "{}", target.name());
+        for (name, bytes) in &files {
+            assert!(*bytes == std::fs::read(dir.join(name)).unwrap(), "{}: {name} differs", target.name());
+        }
+    }
 }

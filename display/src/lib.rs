@@ -4,7 +4,7 @@
 //! objects, lights and a camera; [`plan`] decides what of the bake the scene needs (and
 //! leaves the rest out); [`prepare`] bakes that plan or takes it from the cache. The same
 //! shading (`splitsum_shaders::shade`) is drawn by wgpu ([`render`], in a window by
-//! [`view`]) and by a CPU rasteriser ([`raster`]) that checks it; [`model`] reads glTF.
+//! `view`, natively) and by a CPU rasteriser ([`raster`]) that checks it; [`model`] reads glTF.
 //!
 //! Depends on `splitsum` (the bake) and nothing above it.
 
@@ -17,4 +17,6 @@ pub mod prepare;
 pub mod raster;
 pub mod render;
 pub mod scene;
+/// The window (winit): native systems only; a web page draws with [`render`] on its canvas.
+#[cfg(not(target_arch = "wasm32"))]
 pub mod view;

@@ -17,13 +17,9 @@
 //! `ktx2::Written`, as `VK_FORMAT_B10G11R11_UFLOAT_PACK32`, the same texel), negative
 //! values as 0.
 
-use crate::error::Result;
-use crate::files::write_atomic;
 use crate::ktx2::{VK_FORMAT_B10G11R11_UFLOAT_PACK32, Written};
 use crate::texture::Cube;
 use splitsum_shaders::half::{UFLOAT10_MAX, UFLOAT11_MAX, pack_r11g11b10f};
-use std::io::Write;
-use std::path::Path;
 
 /// The KTX 1.1 identifier.
 pub const IDENTIFIER: [u8; 12] = [0xAB, 0x4B, 0x54, 0x58, 0x20, 0x31, 0x31, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A];
@@ -58,9 +54,3 @@ pub fn encode(cube: &Cube, metadata: &[(&str, &str)]) -> (Vec<u8>, Written) {
     (out, written)
 }
 
-/// Writes `cube` to `path` as KTX 1.1 ([`encode`]), atomically.
-pub fn write(path: &Path, cube: &Cube, metadata: &[(&str, &str)]) -> Result<Written> {
-    let (bytes, written) = encode(cube, metadata);
-    write_atomic(path, |w| w.write_all(&bytes))?;
-    Ok(written)
-}

@@ -219,18 +219,7 @@ fn container(kformat: ::ktx2::Format, size: u32, faces: u32, payloads: Vec<Vec<u
 
 /// Writes `cube` to `path` as KTX2 (atomically).
 pub fn write(path: &Path, cube: &Cube, format: Format) -> Result<Written> {
-    write_with(path, cube, format, Supercompression::None)
-}
-
-/// Writes `cube` to `path` as KTX2 supercompressed by `sc` (atomically).
-pub fn write_with(path: &Path, cube: &Cube, format: Format, sc: Supercompression) -> Result<Written> {
-    let (bytes, written) = encode_with(cube, format, sc);
+    let (bytes, written) = encode_with(cube, format, Supercompression::None);
     write_atomic(path, |w| w.write_all(&bytes))?;
     Ok(written)
-}
-
-/// Writes the BRDF table to `path` as a 2D `R16G16_SFLOAT` KTX2 ([`encode_table`]).
-pub fn write_table(path: &Path, lut: &Lut, sc: Supercompression) -> Result<()> {
-    let bytes = encode_table(lut, sc);
-    write_atomic(path, |w| w.write_all(&bytes))
 }

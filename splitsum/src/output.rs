@@ -7,7 +7,7 @@ use crate::bake::{Baked, Timing};
 use crate::adjustment::Adjustment;
 use crate::environment::InputReport;
 use crate::error::Result;
-use crate::files;
+use crate::files::{self, Sink};
 use crate::ktx1;
 use crate::ktx2;
 use crate::ktx2::Supercompression;
@@ -164,8 +164,23 @@ internal! {
     /// [`write()`] into the folder `dir` as it is (created if missing), each file atomically and
     /// `bake.json` last.
     pub fn write_into(dir: &Path, name: &str, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
-        let _step = crate::progress::step("writing the files", None);
         files::create_folder(dir)?;
+        write_to(&files::Folder(dir), name, baked, job, about)
+    }
+}
+
+/// The files [`write()`] writes for a folder called `name`, in memory (where there is no
+/// file system: a web page), by name, with the manifest. They are the same bytes.
+pub fn in_memory(name: &str, baked: &Baked, job: &Job, about: About) -> Result<(Manifest, Vec<(String, Vec<u8>)>)> {
+    let sink = files::Memory::default();
+    let manifest = write_to(&sink, name, baked, job, about)?;
+    Ok((manifest, sink.into_files()))
+}
+
+internal! {
+    /// [`write()`] through `sink`, `bake.json` last.
+    pub fn write_to(sink: &dyn Sink, name: &str, baked: &Baked, job: &Job, about: About) -> Result<Manifest> {
+        let _step = crate::progress::step("writing the files", None);
         let mut manifest = Manifest {
             environment: about.environment,
             backend: about.backend,
@@ -183,14 +198,14 @@ internal! {
         manifest.adjustments = about.input.as_ref().map_or_else(Vec::new, |input| input.adjustments_for(job.input));
         manifest.adjustments.extend(job.adjustments());
         if job.target != Target::Splitsum {
-            manifest.files = engine_files(dir, name, baked, job)?;
-            return write_manifest(dir, manifest);
+            manifest.files = engine_files(sink, name, baked, job)?;
+            return write_manifest(sink, manifest);
         }
         // Each file is a job of its own, run on every core at once; the manifest lists them
         // in this order.
         let sky = baked.cube(Product::SourceCube).or(baked.cube(Product::Specular));
         let exposure = sky.map_or(1.0, preview::auto_exposure);
-        let jobs: Vec<FileJob<'_>> = baked.products().flat_map(|p| splitsum_files(p, dir, baked, job, exposure)).collect();
+        let jobs: Vec<FileJob<'_>> = baked.products().flat_map(|p| splitsum_files(p, sink, baked, job, exposure)).collect();
         let files_out: Vec<OutputFile> = {
             use rayon::prelude::*;
             jobs.into_par_iter().map(|j| j()).collect::<Result<Vec<_>>>()?.into_iter().flatten().collect()
@@ -199,21 +214,21 @@ internal! {
         if let (Some(sh), Some(irr)) = (baked.sh9(), baked.cube(Product::Irradiance)) {
             manifest.sh9_vs_convolution = Some(sh9_error(sh, irr));
         }
-        write_manifest(dir, manifest)
+        write_manifest(sink, manifest)
     }
 }
 
 /// One file (or a few) of the splitsum folder, written on a core of its own.
 type FileJob<'a> = Box<dyn FnOnce() -> Result<Vec<OutputFile>> + Send + 'a>;
 
-/// The files of product `p` in splitsum's folder `dir`: a prefiltered cube (any lobe) as
+/// The files of product `p` in splitsum's folder (`sink`): a prefiltered cube (any lobe) as
 /// `KEY.ktx2` with a preview of its mips (and the specular cube's mips as EXR), the
 /// irradiance as KTX2, EXR and a preview, SH9 as JSON, each table as EXR (with a preview
 /// of the BRDF table), the source cube as a preview; previews at `exposure`.
-fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job, exposure: f32) -> Vec<FileJob<'a>> {
+fn splitsum_files<'a>(p: Product, sink: &'a dyn Sink, baked: &'a Baked, job: &'a Job, exposure: f32) -> Vec<FileJob<'a>> {
     let file = |name: &str, what: String, written: Option<ktx2::Written>| OutputFile { name: name.to_string(), what, written };
     let save_png = move |name: &str, pic: &preview::Picture| -> Result<()> {
-        files::write_png(&dir.join(name), pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
+        put_png(sink, name, pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
     };
     let mut jobs: Vec<FileJob<'a>> = Vec::new();
     if p.lobe().is_some() {
@@ -222,7 +237,7 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
         let mapping = job.prefiltered[&p].mapping;
         jobs.push(Box::new(move || {
             let name = format!("{key}.ktx2");
-            let w = ktx2::write(&dir.join(&name), cube, job.format)?;
+            let w = put_ktx2(sink, &name, cube, job.format, Supercompression::None)?;
             report_clamp(&name, &w);
             Ok(vec![file(&name, format!("{}, one roughness per mip ({} mapping: settings.prefiltered.{key}.roughness_per_mip)", p.about(), mapping.name()), Some(w))])
         }));
@@ -230,7 +245,8 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
             for m in 0..cube.layout.levels {
                 jobs.push(Box::new(move || {
                     let name = format!("specular_mip{m}.exr");
-                    files::write_cube_level_exr(&dir.join(&name), cube, m, &format!("prefiltered radiance at roughness {}", job.roughness_per_mip()[m as usize]))?;
+                    let what = format!("prefiltered radiance at roughness {}", job.roughness_per_mip()[m as usize]);
+                    sink.put(&name, &files::encode_cube_level_exr(Path::new(&name), cube, m, &what)?)?;
                     Ok(vec![file(&name, format!("mip {m} as EXR for inspection"), None)])
                 }));
             }
@@ -253,9 +269,9 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
         Product::Irradiance => {
             let Some(irr) = baked.cube(p) else { return jobs };
             jobs.push(Box::new(move || {
-                let w = ktx2::write(&dir.join("irradiance.ktx2"), irr, job.format)?;
+                let w = put_ktx2(sink, "irradiance.ktx2", irr, job.format, Supercompression::None)?;
                 report_clamp("irradiance.ktx2", &w);
-                files::write_cube_level_exr(&dir.join("irradiance.exr"), irr, 0, "irradiance / pi")?;
+                sink.put("irradiance.exr", &files::encode_cube_level_exr(Path::new("irradiance.exr"), irr, 0, "irradiance / pi")?)?;
                 save_png("preview_irradiance.png", &preview::cross(irr, 0, 64))?;
                 Ok(vec![
                     file("irradiance.ktx2", "irradiance divided by π (cosine-weighted mean radiance)".into(), Some(w)),
@@ -274,15 +290,15 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
                     irradiance_over_pi: std::array::from_fn(|k| sh.radiance[k].map(|v| v * SH9_COSINE[k] as f64)),
                 };
                 let json = serde_json::to_string_pretty(&file_contents).expect("serialisable");
-                files::write_atomic(&dir.join("sh9.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+                sink.put("sh9.json", json.as_bytes())?;
                 Ok(vec![file("sh9.json", format!("{SH9} spherical-harmonic coefficients of radiance and of E/π"), None)])
             }));
         }
         Product::BrdfTable => {
             let Some(lut) = baked.table(p) else { return jobs };
             jobs.push(Box::new(move || {
-                files::write_lut_exr(&dir.join("brdf_lut.exr"), lut)?;
-                files::write_png(&dir.join("brdf_lut.png"), lut.size, lut.size, &files::lut_preview(lut))?;
+                sink.put("brdf_lut.exr", &files::encode_lut_exr(Path::new("brdf_lut.exr"), lut)?)?;
+                put_png(sink, "brdf_lut.png", lut.size, lut.size, &files::lut_preview(lut))?;
                 Ok(vec![
                     file("brdf_lut.exr", "split-sum BRDF table: R = scale, G = bias; x = n·v, y = roughness".into(), None),
                     file("brdf_lut.png", "its 8-bit preview".into(), None),
@@ -292,7 +308,7 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
         Product::SheenTables => {
             let Some(tables) = baked.table(p) else { return jobs };
             jobs.push(Box::new(move || {
-                files::write_lut_exr(&dir.join("sheen_tables.exr"), tables)?;
+                sink.put("sheen_tables.exr", &files::encode_lut_exr(Path::new("sheen_tables.exr"), tables)?)?;
                 Ok(vec![file(
                     "sheen_tables.exr",
                     "sheen tables: R = Charlie table (Neubelt visibility; the glTF Sample Viewer's lut_charlie), G = sheen albedo (Charlie visibility; lut_sheen_E); x = n·v, y = sheen roughness".into(),
@@ -305,13 +321,25 @@ fn splitsum_files<'a>(p: Product, dir: &'a Path, baked: &'a Baked, job: &'a Job,
     jobs
 }
 
-fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
+fn write_manifest(sink: &dyn Sink, manifest: Manifest) -> Result<Manifest> {
     let json = serde_json::to_string_pretty(&manifest).expect("serialisable");
-    files::write_atomic(&dir.join("bake.json"), |w| std::io::Write::write_all(w, json.as_bytes()))?;
+    sink.put("bake.json", json.as_bytes())?;
     Ok(manifest)
 }
 
-/// The files an engine target's loader reads, written into `dir`: only those (a
+/// `cube` as KTX2 (`ktx2::encode_with`) stored as `name`, with what writing it changed.
+fn put_ktx2(sink: &dyn Sink, name: &str, cube: &Cube, format: crate::texture::Format, sc: Supercompression) -> Result<ktx2::Written> {
+    let (bytes, written) = ktx2::encode_with(cube, format, sc);
+    sink.put(name, &bytes)?;
+    Ok(written)
+}
+
+/// 8-bit RGB pixels as a PNG stored as `name`.
+fn put_png(sink: &dyn Sink, name: &str, width: u32, height: u32, rgb: &[u8]) -> Result<()> {
+    sink.put(name, &files::encode_rgb8(Path::new(name), width, height, rgb, files::FileKind::Png)?)
+}
+
+/// The files an engine target's loader reads, stored in `sink`: only those (a
 /// product the engine does not read is neither baked, see `Target::products`, nor
 /// written). The README cites the engine lines that load each.
 ///
@@ -326,7 +354,7 @@ fn write_manifest(dir: &Path, manifest: Manifest) -> Result<Manifest> {
 /// - `filament`: `NAME_ibl.ktx` (specular mips, KTX 1.1 `R11F_G11F_B10F`, SH in its `sh`
 ///   metadata), `NAME_skybox.ktx` (the source cube's level 0) and `sh.txt`: cmgen
 ///   `--format=ktx --deploy`.
-pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> Result<Vec<OutputFile>> {
+pub(crate) fn engine_files(sink: &dyn Sink, name: &str, baked: &Baked, job: &Job) -> Result<Vec<OutputFile>> {
     let mut out = Vec::new();
     let mut add = |name: String, what: &str, written: Option<ktx2::Written>| {
         out.push(OutputFile { name, what: what.into(), written });
@@ -341,35 +369,30 @@ pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> 
             } else {
                 ("specular.ktx2", "diffuse.ktx2", Supercompression::Zstd)
             };
-            if khronos {
-                files::create_folder(&dir.join("ggx"))?;
-                files::create_folder(&dir.join("lambertian"))?;
-            }
             let spec = baked.cube(Product::Specular).ok_or_else(|| missing("specular cube"))?;
-            let w = ktx2::write_with(&dir.join(spec_name), spec, job.format, sc)?;
+            let w = put_ktx2(sink, spec_name, spec, job.format, sc)?;
             report_clamp(spec_name, &w);
             add(spec_name.into(), "GGX-prefiltered radiance, mip m at perceptual roughness m/(mips-1)", Some(w));
             let irr = baked.cube(Product::Irradiance).ok_or_else(|| missing("irradiance cube"))?;
-            let w = ktx2::write_with(&dir.join(diffuse_name), irr, job.format, sc)?;
+            let w = put_ktx2(sink, diffuse_name, irr, job.format, sc)?;
             report_clamp(diffuse_name, &w);
             add(diffuse_name.into(), "irradiance divided by pi (Lambertian-filtered radiance)", Some(w));
             let lut = baked.table(Product::BrdfTable).ok_or_else(|| missing("BRDF table"))?;
             if khronos {
-                files::write_png(&dir.join("lut_ggx.png"), lut.size, lut.size, &files::lut_preview(lut))?;
+                put_png(sink, "lut_ggx.png", lut.size, lut.size, &files::lut_preview(lut))?;
                 add("lut_ggx.png".into(), "split-sum table, height-correlated Smith: R = A, G = B (8-bit), x = n.v, y = roughness", None);
                 if let Some(sheen) = baked.cube(Product::Sheen) {
-                    files::create_folder(&dir.join("charlie"))?;
-                    let w = ktx2::write_with(&dir.join("charlie/sheen.ktx2"), sheen, job.format, sc)?;
+                    let w = put_ktx2(sink, "charlie/sheen.ktx2", sheen, job.format, sc)?;
                     report_clamp("charlie/sheen.ktx2", &w);
                     add("charlie/sheen.ktx2".into(), "Charlie-prefiltered radiance (sheen), mip m at sheen roughness m/(mips-1)", Some(w));
                     let t = baked.table(Product::SheenTables).ok_or_else(|| missing("sheen tables"))?;
-                    files::write_png(&dir.join("lut_charlie.png"), t.size, t.size, &files::table_channel_png(t, |v| v.x))?;
+                    put_png(sink, "lut_charlie.png", t.size, t.size, &files::table_channel_png(t, |v| v.x))?;
                     add(
                         "lut_charlie.png".into(),
                         "Charlie table (sheen albedo with Neubelt's visibility) in every channel (the viewer reads B), 8-bit, values above 1 written as 1; x = n.v, y = sheen roughness",
                         None,
                     );
-                    files::write_png(&dir.join("lut_sheen_E.png"), t.size, t.size, &files::table_channel_png(t, |v| v.y))?;
+                    put_png(sink, "lut_sheen_E.png", t.size, t.size, &files::table_channel_png(t, |v| v.y))?;
                     add(
                         "lut_sheen_E.png".into(),
                         "sheen albedo with the Charlie visibility (albedo scaling) in every channel (the viewer reads R), 8-bit, values above 1 written as 1; x = n.v, y = sheen roughness",
@@ -377,7 +400,7 @@ pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> 
                     );
                 }
             } else {
-                ktx2::write_table(&dir.join("dfg.ktx2"), lut, sc)?;
+                sink.put("dfg.ktx2", &ktx2::encode_table(lut, sc))?;
                 add(
                     "dfg.ktx2".into(),
                     "split-sum table, height-correlated Smith, R16G16_SFLOAT: R = A, G = B, x = n.v, y = perceptual roughness (Bevy's DfgLut)",
@@ -394,7 +417,8 @@ pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> 
                 c.iter().zip(NAMES).map(|(v, n)| format!("({:18.15}, {:18.15}, {:18.15}); // {n}, irradiance, pre-scaled base\n", v.x, v.y, v.z)).collect();
             let spec = baked.cube(Product::Specular).ok_or_else(|| missing("specular cube"))?;
             let ibl = format!("{name}_ibl.ktx");
-            let w = ktx1::write(&dir.join(&ibl), spec, &[("sh", &metadata)])?;
+            let (bytes, w) = ktx1::encode(spec, &[("sh", &metadata)]);
+            sink.put(&ibl, &bytes)?;
             report_clamp(&ibl, &w);
             add(
                 ibl,
@@ -403,10 +427,11 @@ pub(crate) fn engine_files(dir: &Path, name: &str, baked: &Baked, job: &Job) -> 
             );
             let sky = baked.cube(Product::SourceCube).ok_or_else(|| missing("source cube (the skybox)"))?.levels(0, 0);
             let skybox = format!("{name}_skybox.ktx");
-            let w = ktx1::write(&dir.join(&skybox), &sky, &[])?;
+            let (bytes, w) = ktx1::encode(&sky, &[]);
+            sink.put(&skybox, &bytes)?;
             report_clamp(&skybox, &w);
             add(skybox, "the environment as a cube (KTX 1.1, R11F_G11F_B10F)", Some(w));
-            files::write_atomic(&dir.join("sh.txt"), |w| std::io::Write::write_all(w, text.as_bytes()))?;
+            sink.put("sh.txt", text.as_bytes())?;
             add("sh.txt".into(), "E/pi as 9 RGB coefficients of 1, y, z, x, xy, yz, 3z^2-1, xz, x^2-y^2 (cmgen --sh-shader)", None);
         }
     }

@@ -23,7 +23,7 @@ mod openexr;
 mod radiance;
 mod reduce;
 use openexr::{exr_header, read_exr};
-use radiance::{check_hdr_length, read_hdr, rgbe};
+use radiance::{check_hdr_length, read_hdr, read_hdr_from, rgbe};
 use reduce::{Reducer, Weights};
 
 /// Largest image side accepted (a 32768×16384 RGBA f32 equirect is 8 GiB).
@@ -180,6 +180,31 @@ internal! {
         let (image, report) = read_reduced(path, sanitize, factor)?;
         Ok((Environment::Equirect(image), InputReport { read_for: face, ..report }))
     }
+}
+
+/// Reads an equirect `.hdr` or `.exr` file held in memory (`bytes`, a file called `name`:
+/// dropped on a web page) as [`load`] reads one from disk: the same checks, reduced to the
+/// resolution a 1024-wide cube face resolves as it is decoded.
+pub fn read_bytes(name: &str, bytes: &[u8], sanitize: bool) -> Result<(Environment, InputReport)> {
+    let path = Path::new(name);
+    let len = bytes.len() as u64;
+    let kind = match bytes {
+        [0x76, 0x2f, 0x31, 0x01, ..] => Kind::Exr,
+        [b'#', b'?', ..] => Kind::Hdr,
+        [] => return Err(Error::file(path, "is empty")),
+        _ => return Err(Error::file(path, "is neither an OpenEXR nor a Radiance HDR file (unknown signature)")),
+    };
+    let (width, height) = match kind {
+        Kind::Exr => exr_header(path, &mut std::io::Cursor::new(bytes), len)?.size,
+        Kind::Hdr => rgbe::header(path, &mut std::io::Cursor::new(bytes))?,
+    };
+    check_equirect_shape(path, width, height)?;
+    let factor = equirect::reduction_factor(width, height, NATIVE_FACE);
+    let (image, report) = match kind {
+        Kind::Exr => read_exr(path, std::io::Cursor::new(bytes), len, Weights::EquirectRows, sanitize, factor)?,
+        Kind::Hdr => read_hdr_from(path, std::io::Cursor::new(bytes), len, Weights::EquirectRows, sanitize, factor)?,
+    };
+    Ok((Environment::Equirect(image), InputReport { read_for: NATIVE_FACE, ..report }))
 }
 
 /// The six face files of a cube map folder.

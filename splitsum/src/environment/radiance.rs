@@ -16,10 +16,14 @@ pub(super) fn check_hdr_length(path: &Path, h: u32, len: u64) -> Result<()> {
 
 /// A Radiance `.hdr` file, decoded scanline by scanline into a [`Reducer`] ([`rgbe`]).
 pub(super) fn read_hdr(path: &Path, weights: Weights, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
-    let mut r = buffered(path)?;
+    read_hdr_from(path, buffered(path)?, file_len(path)?, weights, sanitize, factor)
+}
+
+/// [`read_hdr`] from `r`, which holds `len` bytes; `path` names it in errors.
+pub(super) fn read_hdr_from(path: &Path, mut r: impl std::io::BufRead, len: u64, weights: Weights, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
     let (w, h) = rgbe::header(path, &mut r)?;
     check_side(path, w, h)?;
-    check_hdr_length(path, h, file_len(path)?)?;
+    check_hdr_length(path, h, len)?;
     let mut reducer = Reducer::new(w, h, factor, weights, sanitize);
     let mut line = vec![[0u8; 4]; w as usize];
     for y in 0..h {

@@ -208,8 +208,9 @@ pub fn create_folder(dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::file_caused(dir, "cannot create the output folder", e))
 }
 
-/// Writes the BRDF table as a two-channel (R = scale, G = bias) 32-bit float OpenEXR.
-pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
+/// The BRDF table as a two-channel (R = scale, G = bias) 32-bit float OpenEXR; `name`
+/// names it in an error.
+pub fn encode_lut_exr(name: &Path, lut: &Lut) -> Result<Vec<u8>> {
     use exr::prelude::*;
     let size = lut.size as usize;
     let pixels = SpecificChannels::build().with_channel("R").with_channel("G").with_pixel_fn(|pos: Vec2<usize>| {
@@ -222,8 +223,14 @@ pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
     let encoding = Encoding { line_order: LineOrder::Increasing, ..Encoding::FAST_LOSSLESS };
     let image = Image::from_encoded_channels((size, size), encoding, pixels);
     let mut buf = std::io::Cursor::new(Vec::new());
-    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file_caused(path, "could not encode", e))?;
-    write_atomic(path, |w| w.write_all(buf.get_ref()))
+    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file_caused(name, "could not encode", e))?;
+    Ok(buf.into_inner())
+}
+
+/// Writes the BRDF table as [`encode_lut_exr`] does.
+pub fn write_lut_exr(path: &Path, lut: &Lut) -> Result<()> {
+    let bytes = encode_lut_exr(path, lut)?;
+    write_atomic(path, |w| w.write_all(&bytes))
 }
 
 /// Writes an 8-bit RGB PNG from row-major `rgb` (values already in [0, 255]).
@@ -233,16 +240,22 @@ pub fn write_png(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<()>
 
 /// Writes an 8-bit RGB image from row-major `rgb` as `kind` (PNG, or JPEG at quality 95).
 pub fn write_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8], kind: FileKind) -> Result<()> {
-    let img = image::RgbImage::from_raw(width, height, rgb.to_vec()).ok_or_else(|| Error::file(path, "image buffer has the wrong size"))?;
-    write_atomic(path, |w| {
-        let mut buf = std::io::Cursor::new(Vec::new());
-        if kind == FileKind::Jpeg {
-            image::codecs::jpeg::JpegEncoder::new_with_quality(&mut buf, 95).encode_image(&img).map_err(std::io::Error::other)?;
-        } else {
-            img.write_to(&mut buf, kind.image_format()).map_err(std::io::Error::other)?;
-        }
-        w.write_all(buf.get_ref())
-    })
+    let bytes = encode_rgb8(path, width, height, rgb, kind)?;
+    write_atomic(path, |w| w.write_all(&bytes))
+}
+
+/// An 8-bit RGB image from row-major `rgb` encoded as `kind` (PNG, or JPEG at quality 95);
+/// `name` names it in an error.
+pub fn encode_rgb8(name: &Path, width: u32, height: u32, rgb: &[u8], kind: FileKind) -> Result<Vec<u8>> {
+    let img = image::RgbImage::from_raw(width, height, rgb.to_vec()).ok_or_else(|| Error::file(name, "image buffer has the wrong size"))?;
+    let mut buf = std::io::Cursor::new(Vec::new());
+    let encoded = if kind == FileKind::Jpeg {
+        image::codecs::jpeg::JpegEncoder::new_with_quality(&mut buf, 95).encode_image(&img)
+    } else {
+        img.write_to(&mut buf, kind.image_format())
+    };
+    encoded.map_err(|e| Error::file_caused(name, "could not encode", std::io::Error::other(e)))?;
+    Ok(buf.into_inner())
 }
 
 /// The BRDF table as an 8-bit preview: R = scale, G = bias, values in [0, 1] stored
@@ -263,6 +276,13 @@ fn to_u8(v: f32) -> u8 {
 
 /// Writes RGB float pixels (alpha dropped) as a 32-bit float OpenEXR with a comment.
 pub fn write_rgb_exr(path: &Path, width: u32, height: u32, pixels: &[splitsum_shaders::glam::Vec4], comment: &str) -> Result<()> {
+    let bytes = encode_rgb_exr(path, width, height, pixels, comment)?;
+    write_atomic(path, |w| w.write_all(&bytes))
+}
+
+/// RGB float pixels (alpha dropped) as a 32-bit float OpenEXR with a comment; `name` names
+/// it in an error.
+pub fn encode_rgb_exr(name: &Path, width: u32, height: u32, pixels: &[splitsum_shaders::glam::Vec4], comment: &str) -> Result<Vec<u8>> {
     use exr::prelude::*;
     let w = width as usize;
     let mut attributes = LayerAttributes::named("rgb");
@@ -280,16 +300,16 @@ pub fn write_rgb_exr(path: &Path, width: u32, height: u32, pixels: &[splitsum_sh
     );
     let image = Image::from_layer(layer);
     let mut buf = std::io::Cursor::new(Vec::new());
-    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file_caused(path, "could not encode", e))?;
-    write_atomic(path, |w| w.write_all(buf.get_ref()))
+    image.write().to_buffered(&mut buf).map_err(|e| crate::error::Error::file_caused(name, "could not encode", e))?;
+    Ok(buf.into_inner())
 }
 
-/// Writes level `level` of `cube` as a vertical strip of its six faces (+X, −X, +Y, −Y,
-/// +Z, −Z from the top, each in Vulkan/KTX2 orientation) to an OpenEXR file.
-pub fn write_cube_level_exr(path: &Path, cube: &crate::texture::Cube, level: u32, what: &str) -> Result<()> {
+/// Level `level` of `cube` as a vertical strip of its six faces (+X, −X, +Y, −Y, +Z, −Z
+/// from the top, each in Vulkan/KTX2 orientation), encoded as OpenEXR.
+pub fn encode_cube_level_exr(name: &Path, cube: &crate::texture::Cube, level: u32, what: &str) -> Result<Vec<u8>> {
     let s = cube.layout.level_size(level);
-    write_rgb_exr(
-        path,
+    encode_rgb_exr(
+        name,
         s,
         6 * s,
         cube.level(level),
@@ -299,9 +319,11 @@ pub fn write_cube_level_exr(path: &Path, cube: &crate::texture::Cube, level: u32
 
 mod folder;
 mod manifest;
+mod sink;
 
 pub use folder::{OutputDir, remove_staging_on_interrupt};
 pub use manifest::{OUTPUT_MANIFEST, Verified, check_replaceable};
+pub use sink::{Folder, Memory, Sink};
 
 /// Staging folders not yet committed, and the folders created for them: removed if the
 /// process is interrupted (SIGINT, SIGTERM, SIGHUP), under this lock, which a commit holds
