@@ -117,30 +117,18 @@ ensure_gl() {
     ensure_packages '/usr/lib/*/libEGL.so.1:libegl1' '/usr/lib/*/libEGL_mesa.so.0:libegl-mesa0' '/usr/lib/*/libGLESv2.so.2:libgles2' '/usr/lib/*/dri/swrast_dri.so:libgl1-mesa-dri'
 }
 
-# The library in a browser (tests/webgpu): the wasm32 target, the wasm-bindgen CLI at the
-# version tests/webgpu/Cargo.lock pins (crates.io), the page's crate built for wasm32 and
-# bound, and puppeteer-core (npm). Chromium comes from ensure_browser.
+# The library and its web page in a browser: the page built into web/dist (scripts/web.sh
+# installs the wasm32 target and the wasm-bindgen CLI it needs) and puppeteer-core (npm)
+# for tests/webgpu. Chromium comes from ensure_browser.
 ensure_webgpu() {
     dry && return 0
-    rustup target add wasm32-unknown-unknown >&2
-    local want
-    want=$(sed -n '/^name = "wasm-bindgen"$/{n;s/^version = "\(.*\)"/\1/p}' tests/webgpu/Cargo.lock)
-    if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $want" ]; then
-        # Not --locked: its lock pins crates (webpki-roots 1.0.11) this registry lacks.
-        # About 2 minutes on two cores.
-        echo "dev.sh: installing wasm-bindgen-cli $want (crates.io)" >&2
-        cargo +stable install --force wasm-bindgen-cli --version "$want" >&2
-    fi
-    (
-        cd tests/webgpu
-        cargo +stable build --release --target wasm32-unknown-unknown >&2
-        wasm-bindgen --target web --out-dir pkg target/wasm32-unknown-unknown/release/splitsum_webgpu_check.wasm
-        [ -d node_modules/puppeteer-core ] || npm install --no-audit --no-fund --silent
-    )
+    bash scripts/web.sh
+    (cd tests/webgpu && { [ -d node_modules/puppeteer-core ] || npm install --no-audit --no-fund --silent; })
 }
 
-# The browser test: run by `test` (with no filter) and by `webgpu`.
-WEBGPU_TEST=(cargo +stable test --release -p splitsum-tests --test suite library::a_bake_in_the_browsers_webgpu_matches_the_cpu -- --ignored --nocapture)
+# The browser tests (the library's bake, the web page): run by `test` (with no filter) and
+# by `webgpu`.
+WEBGPU_TEST=(cargo +stable test --release -p splitsum-tests --test suite -- --ignored --nocapture library::a_bake_in_the_browsers_webgpu_matches_the_cpu web::the_web_page_shows_and_downloads_what_the_command_line_makes)
 
 # The windowed smoke test opens the viewer on Xvfb and screenshots it with xwd.
 ensure_test_display() {

@@ -23,3 +23,4 @@ mod sample_viewer;
 mod sheen;
 mod stability;
 mod targets;
+mod web;

@@ -284,6 +284,23 @@ pub fn read<K: Kernels>(k: &K, made: Made<K::Texels>, job: &Job) -> Result<Baked
     Ok(baked)
 }
 
+/// [`read`] on the GPU without blocking: what a web page does after [`make`] (in a browser
+/// a readback completes only when the page's event loop runs). SH9 is read back inside
+/// [`make`], and so cannot be baked there.
+pub async fn read_async(g: &crate::backend::Gpu, made: Made<crate::backend::gpu::Texels>, job: &Job) -> Result<Baked> {
+    let mut baked = Baked::new(made.timings);
+    for (p, item) in made.items {
+        let host = match (item, job.layout(p)) {
+            (Item::Cube(t), Layout::Cube(layout)) => Item::Cube(Cube { layout, texels: g.read_texels_async(&t).await? }),
+            (Item::Table(t), Layout::Table(size)) => Item::Table(Lut::from_texels(size, &g.read_texels_async(&t).await?)),
+            (Item::Coefficients(c), _) => Item::Coefficients(c),
+            _ => unreachable!("{p} was made in its own layout"),
+        };
+        baked.insert(p, host);
+    }
+    Ok(baked)
+}
+
 /// Bakes `products` of `env` with `settings` on `backend`, into host memory.
 pub fn bake(backend: &Backend, env: &Environment, settings: &Settings, products: Products) -> Result<Baked> {
     let job = settings.resolve(InputShape::of(env), products)?;

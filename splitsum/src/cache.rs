@@ -65,7 +65,9 @@ struct Manifest {
 }
 
 /// Whether `name` is a file [`Cache::put`] writes: the only names the cache removes
-/// (`manifest.json`, and `Product::cache_file` of each product).
+/// (`manifest.json`, and `Product::cache_file` of each product). Native systems only: a
+/// browser has no cache folder.
+#[cfg(not(target_arch = "wasm32"))]
 fn entry_file(name: &str) -> bool {
     name == "manifest.json" || Product::ALL.iter().any(|p| p.cache_file() == name)
 }

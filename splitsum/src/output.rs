@@ -169,9 +169,11 @@ internal! {
     }
 }
 
+pub use crate::files::Files;
+
 /// The files [`write()`] writes for a folder called `name`, in memory (where there is no
 /// file system: a web page), by name, with the manifest. They are the same bytes.
-pub fn in_memory(name: &str, baked: &Baked, job: &Job, about: About) -> Result<(Manifest, Vec<(String, Vec<u8>)>)> {
+pub fn in_memory(name: &str, baked: &Baked, job: &Job, about: About) -> Result<(Manifest, Files)> {
     let sink = files::Memory::default();
     let manifest = write_to(&sink, name, baked, job, about)?;
     Ok((manifest, sink.into_files()))

@@ -1,51 +1,30 @@
-// Serves this folder on loopback, opens it in headless Chromium with WebGPU (SwiftShader),
+// Serves the web page's build (web/dist) on loopback, opens it in headless Chromium with WebGPU (SwiftShader),
 // bakes the equirect in INPUT (little-endian f32: width, height, size, then RGB texels)
 // with splitsum's kernels on the page's WebGPU device, and writes what the textures hold
 // to OUTPUT (f32), or the browser's message to OUTPUT.err.
-import { createServer } from "node:http";
 import { readFile, writeFile } from "node:fs/promises";
-import { extname, join } from "node:path";
-import puppeteer from "puppeteer-core";
 import { sampleGpuPeak } from "./gpu-memory.mjs";
+import { launchChromium, serveFolder } from "./browser.mjs";
 
 const [input, output] = process.argv.slice(2);
-const root = new URL(".", import.meta.url).pathname;
-const types = { ".html": "text/html", ".js": "text/javascript", ".wasm": "application/wasm" };
-const server = createServer(async (req, res) => {
-  try {
-    const body = await readFile(join(root, decodeURIComponent(new URL(req.url, "http://x").pathname)));
-    res.writeHead(200, { "content-type": types[extname(req.url)] ?? "application/octet-stream" });
-    res.end(body);
-  } catch {
-    res.writeHead(404);
-    res.end();
-  }
-}).listen(0, "127.0.0.1");
-await new Promise((r) => server.once("listening", r));
-const browser = await puppeteer.launch({
-  executablePath: "/usr/bin/chromium",
-  headless: true,
-  protocolTimeout: 900_000,
-  dumpio: true,
-  args: ["--no-sandbox", "--disable-gpu-sandbox", "--enable-unsafe-webgpu", "--use-webgpu-adapter=swiftshader", "--disable-background-networking",
-         "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic"],
-});
+// The page's build (bash scripts/web.sh), whose wasm also holds bake_textures.
+const server = await serveFolder(new URL("../../web/dist", import.meta.url).pathname);
+const browser = await launchChromium();
 // The GPU process's peak resident memory goes in OUTPUT.txt and OUTPUT.peak (bytes).
 const sampler = sampleGpuPeak(browser);
 try {
   const page = await browser.newPage();
   page.on("console", (m) => console.error("page:", m.text()));
-  await page.goto(`http://127.0.0.1:${server.address().port}/index.html`);
+  await page.goto(`http://127.0.0.1:${server.address().port}/index.html?check`);
+  await page.waitForFunction(() => window.splitsumWasm, { timeout: 300_000 });
   const bytes = await readFile(input);
   const header = new Uint32Array(bytes.buffer, bytes.byteOffset, 3);
   const texels = Array.from(new Float32Array(bytes.buffer, bytes.byteOffset + 12, (bytes.length - 12) / 4));
   const result = await page.evaluate(async (texels, w, h, size) => {
-    const s = await window.splitsum;
+    const s = window.splitsumWasm;
     try {
-
-
       const t0 = performance.now();
-      const out = await s.bake(new Float32Array(texels), w, h, size);
+      const out = await s.bake_textures(new Float32Array(texels), w, h, size);
       return { ms: performance.now() - t0, out: Array.from(out) };
     } catch (e) {
       return { error: String(e) };

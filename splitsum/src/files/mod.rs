@@ -323,7 +323,7 @@ mod sink;
 
 pub use folder::{OutputDir, remove_staging_on_interrupt};
 pub use manifest::{OUTPUT_MANIFEST, Verified, check_replaceable};
-pub use sink::{Folder, Memory, Sink};
+pub use sink::{Files, Folder, Memory, Sink};
 
 /// Staging folders not yet committed, and the folders created for them: removed if the
 /// process is interrupted (SIGINT, SIGTERM, SIGHUP), under this lock, which a commit holds

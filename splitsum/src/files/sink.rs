@@ -6,6 +6,9 @@ use crate::error::Result;
 use std::path::Path;
 use std::sync::Mutex;
 
+/// Files by name (`/`-separated inside the folder), with their bytes.
+pub type Files = Vec<(String, Vec<u8>)>;
+
 /// Receives the files of an output folder, by name.
 pub trait Sink: Sync {
     /// Stores `bytes` as `name`: a relative, `/`-separated path that splitsum chose (its
@@ -35,7 +38,7 @@ impl Sink for Memory {
 
 impl Memory {
     /// The files stored, by name (files written at once arrive in any order).
-    pub fn into_files(self) -> Vec<(String, Vec<u8>)> {
+    pub fn into_files(self) -> Files {
         let mut files = self.0.into_inner().unwrap_or_else(|e| e.into_inner());
         files.sort_by(|a, b| a.0.cmp(&b.0));
         files

@@ -441,6 +441,13 @@ impl Gpu {
     internal! {
         /// Waits for the queue and copies `buffer` back.
         pub fn read_bytes(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+            pollster::block_on(self.read_bytes_async(buffer))
+        }
+    }
+
+    internal! {
+        /// [`Gpu::read_bytes`] without blocking (in a browser, where nothing may block).
+        pub async fn read_bytes_async(&self, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
             let size = buffer.size();
             let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("readback"),
@@ -451,7 +458,7 @@ impl Gpu {
             let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
             encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
             self.queue.submit([encoder.finish()]);
-            map_read(&self.device, &staging)
+            map_read_async(&self.device, &staging).await
         }
     }
 }

@@ -109,7 +109,14 @@ impl Gpu {
     internal! {
         /// `texels` back in host memory.
         pub fn read_texels(&self, texels: &Texels) -> Result<Vec<Vec4>> {
-            let bytes = self.read_bytes(&texels.buffer)?;
+            pollster::block_on(self.read_texels_async(texels))
+        }
+    }
+
+    internal! {
+        /// [`Gpu::read_texels`] without blocking (in a browser, where nothing may block).
+        pub async fn read_texels_async(&self, texels: &Texels) -> Result<Vec<Vec4>> {
+            let bytes = self.read_bytes_async(&texels.buffer).await?;
             Ok(bytemuck::pod_collect_to_vec(&bytes[..texels.count as usize * 16]))
         }
     }

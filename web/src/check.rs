@@ -1,4 +1,5 @@
-//! The page side of `bash scripts/dev.sh webgpu` (and of `dev.sh test`): splitsum baking on the browser's WebGPU device.
+//! The page side of the browser test of the library alone (`bash scripts/dev.sh webgpu`, and
+//! `dev.sh test`): splitsum baking through `Baker` on the browser's WebGPU device.
 
 use splitsum::glam::Vec4;
 use splitsum::texture::Equirect;
@@ -6,11 +7,7 @@ use splitsum::environment::Environment;
 use splitsum::{Baker, Compute, Product, Settings, Source};
 use wasm_bindgen::prelude::*;
 
-#[wasm_bindgen]
-extern "C" {
-    #[wasm_bindgen(js_namespace = console, js_name = log)]
-    fn console_log(s: &str);
-}
+use super::console_log;
 
 /// The browser's WebGPU adapter and device (with the instance, which must outlive them).
 async fn open() -> Result<(wgpu::Instance, wgpu::Adapter, wgpu::Device, wgpu::Queue), JsValue> {
@@ -28,7 +25,7 @@ async fn open() -> Result<(wgpu::Instance, wgpu::Adapter, wgpu::Device, wgpu::Qu
 /// back: the specular cube, the irradiance cube (RGBA each, every mip) and the table (RG).
 /// Each step, and the device's loss if it is lost, is logged to the console.
 #[wasm_bindgen]
-pub async fn bake(texels: Vec<f32>, width: u32, height: u32, size: u32) -> Result<Vec<f32>, JsValue> {
+pub async fn bake_textures(texels: Vec<f32>, width: u32, height: u32, size: u32) -> Result<Vec<f32>, JsValue> {
     std::panic::set_hook(Box::new(|info| console_log(&format!("panic: {info}"))));
     let (_instance, adapter, device, queue) = open().await?;
     console_log(&format!("adapter: {:?}", adapter.get_info()));
