@@ -1,7 +1,7 @@
 //! The web page (`web/`, built by `bash scripts/web.sh`) as a user meets it, in headless
 //! Chromium's WebGPU (SwiftShader) through `tests/webgpu/page.mjs` (puppeteer-core): a
 //! generated sunny sky dropped on it is baked and drawn, and the grid it shows and the
-//! khronos folder it downloads are checked against the native command line's. Needs what
+//! folder of each target it downloads are checked against the native command line's. Needs what
 //! `bash scripts/dev.sh webgpu` builds and installs (it runs this test, and so does
 //! `dev.sh test`); ignored otherwise.
 
@@ -92,32 +92,34 @@ fn the_web_page_shows_and_downloads_what_the_command_line_makes() {
         assert!(mean <= 2.0, "{name}: mean |Δ| {mean:.3}/255");
     }
 
-    // The khronos download against `runner bake --target khronos` (the CPU backend, as the
+    // Each target's download against `runner bake --target T` (the CPU backend, as the
     // page's downloads): every file byte for byte; bake.json but for what names the run.
-    let cli = dir.join("cli").join("sky");
-    let args = ["runner", "bake", sky.to_str().unwrap(), "--backend", "cpu", "--target", "khronos", "--out", cli.to_str().unwrap()];
-    runner::cli::run(args.map(String::from)).unwrap();
-    let mut want = folder(&cli);
-    want.remove(splitsum::files::OUTPUT_MANIFEST);
-    for (name, _) in runs {
-        let mut zip = zip::ZipArchive::new(std::io::Cursor::new(std::fs::read(dir.join(name).join("khronos.zip")).unwrap())).unwrap();
-        let mut got = BTreeMap::new();
-        for k in 0..zip.len() {
-            let mut f = zip.by_index(k).unwrap();
-            let full = f.name().unwrap().to_string();
-            let file = full.strip_prefix("sky/").unwrap_or_else(|| panic!("{full} is outside the folder sky/")).to_string();
-            let mut bytes = Vec::new();
-            std::io::Read::read_to_end(&mut f, &mut bytes).unwrap();
-            got.insert(file, bytes);
-        }
-        assert_eq!(got.keys().collect::<Vec<_>>(), want.keys().collect::<Vec<_>>(), "{name}: the zip's files");
-        for (file, bytes) in &got {
-            if file == "bake.json" {
-                assert_eq!(bake_json(bytes), bake_json(&want[file]), "{name}: bake.json");
-            } else {
-                assert!(*bytes == want[file], "{name}: {file} differs from the command line's");
+    for target in ["splitsum", "khronos", "bevy", "filament"] {
+        let cli = dir.join("cli").join(target).join("sky");
+        let args = ["runner", "bake", sky.to_str().unwrap(), "--backend", "cpu", "--target", target, "--out", cli.to_str().unwrap()];
+        runner::cli::run(args.map(String::from)).unwrap();
+        let mut want = folder(&cli);
+        want.remove(splitsum::files::OUTPUT_MANIFEST);
+        for (name, _) in runs {
+            let mut zip = zip::ZipArchive::new(std::io::Cursor::new(std::fs::read(dir.join(name).join(format!("{target}.zip"))).unwrap())).unwrap();
+            let mut got = BTreeMap::new();
+            for k in 0..zip.len() {
+                let mut f = zip.by_index(k).unwrap();
+                let full = f.name().unwrap().to_string();
+                let file = full.strip_prefix("sky/").unwrap_or_else(|| panic!("{full} is outside the folder sky/")).to_string();
+                let mut bytes = Vec::new();
+                std::io::Read::read_to_end(&mut f, &mut bytes).unwrap();
+                got.insert(file, bytes);
             }
+            assert_eq!(got.keys().collect::<Vec<_>>(), want.keys().collect::<Vec<_>>(), "{name}: the {target} zip's files");
+            for (file, bytes) in &got {
+                if file == "bake.json" {
+                    assert_eq!(bake_json(bytes), bake_json(&want[file]), "{name}: {target} bake.json");
+                } else {
+                    assert!(*bytes == want[file], "{name}: {target} {file} differs from the command line's");
+                }
+            }
+            eprintln!("{name}: the {target} download, {} files, identical to runner bake --target {target}", got.len());
         }
-        eprintln!("{name}: khronos download, {} files, identical to runner bake --target khronos", got.len());
     }
 }
