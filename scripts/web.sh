@@ -5,6 +5,11 @@
 # web/Cargo.lock pins (crates.io).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# SPLITSUM_DRY_RUN (tests/commands.rs): nothing is installed or built.
+if [ -n "${SPLITSUM_DRY_RUN:-}" ]; then
+    echo "web.sh (dry run): would build web/ for wasm32 and bind it into web/dist" >&2
+    exit 0
+fi
 rustup target add wasm32-unknown-unknown >&2
 want=$(sed -n '/^name = "wasm-bindgen"$/{n;s/^version = "\(.*\)"/\1/p}' web/Cargo.lock)
 if [ "$(wasm-bindgen --version 2>/dev/null)" != "wasm-bindgen $want" ]; then
