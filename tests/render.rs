@@ -82,8 +82,8 @@ fn gpu_matches_the_cpu_reference() {
 
 /// Every shading option of the image-based and direct light (dominant direction, the lift
 /// above the horizon, multiple
-/// scattering, exact Smith for direct light, filtered sampling below mip 1, the table read
-/// as `F₀·A + B`, the shading ladder's 2 to 16 fetches), alone and all together, GPU
+/// scattering, exact Smith for direct light, filtered sampling below mip 1, the common
+/// roughness-aware Fresnel weights, the shading ladder's 2 to 16 fetches), alone and all together, GPU
 /// against CPU, under the same bound as the models.
 #[test]
 fn shading_options_gpu_match_the_cpu_reference() {
@@ -99,7 +99,7 @@ fn shading_options_gpu_match_the_cpu_reference() {
         ShadeOptions::LOG_MIP_BLEND,
         all,
         all & !ShadeOptions::FILTERED_SAMPLING | ShadeOptions::LOG_MIP_BLEND,
-        ShadeOptions::TABLE_F0,
+        ShadeOptions::ROUGHNESS_FRESNEL,
     ];
     let mut views: Vec<ViewState> =
         extras.iter().map(|&extra| ViewState { options: ShadeOptions { flags: base | extra, ..ShadeOptions::DEFAULT }, ..ViewState::default() }).collect();

@@ -114,8 +114,10 @@ fn the_report_page_renders_in_a_browser() {
 /// to a few ULP), and the bake's share (a) of the shaded colour's error is what is left,
 /// the bilinear interpolation of the 256² BRDF table between texel centres where it is
 /// steepest (grazing n·v at low roughness; measured 1.2·10⁻³ relative, bound 5·10⁻³). The
-/// split sum (b) is not zero on a constant sky (the display's roughness-aware Fresnel at
-/// n·v stands in for the table's F₀) but finite.
+/// split sum (b), the exact weights against the full integral of the glTF BRDF, agrees on
+/// a constant sky up to the reference's midpoint rule (`shading::a_constant_sky_shades_exactly`),
+/// but on this 16² source the sub-patch cap leaves the grazing slivers of smooth lobes
+/// unresolved (measured 0.675 at n·v near 10⁻³): finite is what is asserted here.
 #[test]
 fn end_to_end_measure_of_a_constant_sky() {
     use splitsum::environment::Environment;
@@ -136,7 +138,7 @@ fn end_to_end_measure_of_a_constant_sky() {
     let split = worst(Quantity::ShadedColour, Part::SplitSum);
     println!("constant sky: bake share max {bake:.2e}, lookup max {lookup:.2e}, split sum max {split:.2e}");
     assert!(bake < 5e-3 && lookup < 1e-5, "bake {bake:e}, lookup {lookup:e}");
-    assert!(split.is_finite() && split > 0.0);
+    assert!(split.is_finite());
     assert!(rows.iter().any(|r| r.product == Quantity::ShadedColour && r.time_ms.is_some_and(f64::is_finite)));
 }
 

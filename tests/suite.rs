@@ -20,6 +20,7 @@ mod prefilter;
 mod render;
 mod report;
 mod sample_viewer;
+mod shading;
 mod sheen;
 mod stability;
 mod targets;

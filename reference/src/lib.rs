@@ -181,19 +181,54 @@ pub fn irradiance(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3]) -> [f64; 3]
     acc.map(|v| v / PI)
 }
 
+/// The glTF 2.0 metallic–roughness BRDF times `n·l` (glTF 2.0 specification, Appendix
+/// B.3.5, with B.3.4's `fresnel_mix` and `conductor_fresnel`), per channel:
+///
+/// `mix(fresnel_mix(ior 1.5, base/π, spec), conductor_fresnel(base, spec), metallic)`
+/// `= (1 − metallic)(1 − F_d)·base/π + F·spec`, `spec = D G / (4 (n·l)(n·v))`,
+/// with Schlick's `F_d = 0.04 + 0.96(1 − v·h)⁵` (the dielectric, `((1 − 1.5)/(1 + 1.5))²`)
+/// and `F = F₀ + (1 − F₀)(1 − v·h)⁵`, `F₀ = mix(0.04, base, metallic)` (the two layers'
+/// Fresnel terms mixed: Schlick is linear in `F₀`). `d` is GGX's `D(h)` and `g` the masking
+/// term's `G(l, v)`.
+#[allow(clippy::too_many_arguments)]
+pub fn gltf_brdf_cos(base: [f64; 3], metallic: f64, d: f64, g: f64, n_dot_l: f64, n_dot_v: f64, v_dot_h: f64) -> [f64; 3] {
+    let fc = (1.0 - v_dot_h.clamp(0.0, 1.0)).powi(5);
+    let f_dielectric = 0.04 + 0.96 * fc;
+    std::array::from_fn(|c| {
+        let f0 = 0.04 + (base[c] - 0.04) * metallic;
+        let f = f0 + (1.0 - f0) * fc;
+        ((1.0 - metallic) * (1.0 - f_dielectric) * base[c] / PI + d * g * f / (4.0 * n_dot_l * n_dot_v)) * n_dot_l
+    })
+}
+
+/// The cosine-weighted mean of Schlick's weight over the hemisphere of light directions,
+/// `(1/π) ∫ (1 − v·h)⁵ (n·l) dl` with `h` the half vector of `v` and `l`, by nested adaptive
+/// quadrature over `l` in polar coordinates about `n` (`θ` in `[0, π/2]`, `φ` in `[0, π]`
+/// doubled by symmetry), `v·h = √((1 + v·l)/2)`. Under a constant sky the glTF diffuse layer
+/// reflects `(1 − 0.04)(1 − this)` of its albedo.
+pub fn schlick_weight_hemispherical_mean(n_dot_v: f64, tol: f64) -> f64 {
+    let sin_v = (1.0 - n_dot_v * n_dot_v).max(0.0).sqrt();
+    let outer = |theta: f64| {
+        let (st, ct) = theta.sin_cos();
+        let inner = |phi: f64| {
+            let v_dot_l = sin_v * st * phi.cos() + n_dot_v * ct;
+            let v_dot_h = ((1.0 + v_dot_l) / 2.0).max(0.0).sqrt();
+            (1.0 - v_dot_h).powi(5)
+        };
+        2.0 * adaptive(&inner, 0.0, PI, tol) * ct * st
+    };
+    adaptive(&outer, 0.0, PI / 2.0, tol) / PI
+}
+
 /// Reflected radiance towards `v` of a glTF metallic–roughness surface with normal `n`,
 /// lit by every texel of an environment (`texels` from [`texels`]), by the full
-/// reflectance integral with no split:
-///
-/// `L_o = Σ f(l, v) L(l) max(0, n·l) Ω`, with
-/// `f = (1 − F(v·h))(1 − metallic)·base/π + D(h) G(l, v) F(v·h) / (4 (n·l)(n·v))`,
-/// GGX `D` (α = r²) in its textbook form, Smith–Schlick `G` with `k = α/2` (the remapping
-/// the split sum's table uses), Schlick `F` with `F₀ = mix(0.04, base, metallic)`.
+/// reflectance integral with no split: `L_o = Σ f(l, v) L(l) max(0, n·l) Ω` with `f` the
+/// glTF BRDF ([`gltf_brdf_cos`]), GGX `D` (α = r²) in its textbook form and Smith–Schlick
+/// `G` with `k = α/2` (the remapping the split sum's sampled table uses).
 pub fn shade_full(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3], v: [f64; 3], base: [f64; 3], metallic: f64, roughness: f64) -> [f64; 3] {
     let a2 = (roughness * roughness).powi(2);
     let k = roughness * roughness / 2.0;
     let nv = dot(n, v);
-    let f0: [f64; 3] = std::array::from_fn(|c| 0.04 + (base[c] - 0.04) * metallic);
     let g1 = |x: f64| x / (x * (1.0 - k) + k);
     let mut out = [0.0; 3];
     for (l, omega, radiance) in texels {
@@ -205,12 +240,9 @@ pub fn shade_full(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3], v: [f64; 3]
         let nh = dot(n, h);
         let vh = dot(v, h).max(0.0);
         let d = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
-        let g = g1(nv) * g1(nl);
-        let fc = (1.0 - vh).powi(5);
+        let f = gltf_brdf_cos(base, metallic, d, g1(nv) * g1(nl), nl, nv, vh);
         for c in 0..3 {
-            let f = f0[c] + (1.0 - f0[c]) * fc;
-            let brdf = (1.0 - f) * (1.0 - metallic) * base[c] / PI + d * g * f / (4.0 * nl * nv);
-            out[c] += brdf * radiance[c] * nl * omega;
+            out[c] += f[c] * radiance[c] * omega;
         }
     }
     out
@@ -354,14 +386,15 @@ impl Environment {
     }
 
     /// Reflected radiance towards `v` of a glTF metallic–roughness surface by the full
-    /// reflectance integral with no split, as [`shade_full`] but with the masking term
-    /// `smith` and sub-sampled where the specular lobe is narrower than a texel.
+    /// reflectance integral of the glTF BRDF ([`gltf_brdf_cos`]) with no split, as
+    /// [`shade_full`] but with the masking term `smith` (the glTF specification's is
+    /// [`Smith::Correlated`]) and sub-sampled where the specular lobe is narrower than a
+    /// texel.
     #[allow(clippy::too_many_arguments)]
     pub fn shade(&self, n: [f64; 3], v: [f64; 3], base: [f64; 3], metallic: f64, roughness: f64, smith: Smith) -> [f64; 3] {
         let alpha = roughness * roughness;
         let a2 = alpha * alpha;
         let nv = dot(n, v);
-        let f0: [f64; 3] = std::array::from_fn(|c| 0.04 + (base[c] - 0.04) * metallic);
         let half = |l: [f64; 3]| normalize([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
         // The lobe in `l` is `2α` wide in the plane of `v` and `h`, and `2α(v·h)` across it
         // (reflection about `h` scales the perpendicular turn by `v·h`): at grazing views it
@@ -379,12 +412,7 @@ impl Environment {
             let nh = dot(n, h);
             let vh = dot(v, h).max(0.0);
             let d = a2 / (PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
-            let g = smith.g(nv, nl, alpha);
-            let fc = (1.0 - vh).powi(5);
-            std::array::from_fn(|c| {
-                let f = f0[c] + (1.0 - f0[c]) * fc;
-                ((1.0 - f) * (1.0 - metallic) * base[c] / PI + d * g * f / (4.0 * nl * nv)) * nl
-            })
+            gltf_brdf_cos(base, metallic, d, smith.g(nv, nl, alpha), nl, nv, vh)
         };
         self.integrate(w, scale).0
     }

@@ -41,7 +41,7 @@ pub fn method_colour(m: Method) -> RGBColor {
         Method::FilteredSampling => RGBColor(86, 180, 233),
         Method::SmithSchlickTable => RGBColor(230, 159, 0),
         Method::LinearMipBlend => RGBColor(0, 0, 0),
-        Method::TableF0 => RGBColor(240, 228, 66),
+        Method::RoughnessFresnel => RGBColor(240, 228, 66),
         Method::NoHorizonLift => RGBColor(160, 110, 60),
         Method::Ladder => RGBColor(170, 0, 90),
         Method::KhronosBevyLookup => RGBColor(120, 120, 0),

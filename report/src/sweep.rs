@@ -84,7 +84,8 @@ impl Sweep {
         // Each method's error against its bake time: the seed at three sample counts, the
         // defaults at three (mip 1's count; ×2 per mip after it).
         for n in [64, 256, 1024] {
-            methods.push(Method { kind: Kind::Seed, settings: Settings { samples: n, ..seed_settings(src) }, flags: 0 });
+            // The seed's shading: the mirror direction, the roughness-aware Fresnel weights.
+            methods.push(Method { kind: Kind::Seed, settings: Settings { samples: n, ..seed_settings(src) }, flags: ShadeOptions::ROUGHNESS_FRESNEL });
         }
         for n in [16, 256] {
             methods.push(Method { kind: Kind::Defaults, settings: Settings { samples: n, ..default.clone() }, flags });
@@ -95,7 +96,7 @@ impl Sweep {
             Method { kind: Kind::MultipleScattering, settings: default.clone(), flags: flags | ShadeOptions::MULTISCATTER },
             Method { kind: Kind::FilteredSampling, settings: default.clone(), flags: flags | ShadeOptions::FILTERED_SAMPLING },
             Method { kind: Kind::LinearMipBlend, settings: default.clone(), flags: flags & !ShadeOptions::LOG_MIP_BLEND },
-            Method { kind: Kind::TableF0, settings: default.clone(), flags: flags | ShadeOptions::TABLE_F0 },
+            Method { kind: Kind::RoughnessFresnel, settings: default.clone(), flags: flags | ShadeOptions::ROUGHNESS_FRESNEL },
             Method { kind: Kind::NoHorizonLift, settings: default.clone(), flags: flags & !ShadeOptions::LIFT_ABOVE_HORIZON },
         ]);
         // The shading ladder: the defaults' bake read with 2, 4, 8 and 16 fetches.

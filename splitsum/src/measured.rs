@@ -62,8 +62,10 @@ pub enum Method {
     LinearMipBlend,
     /// The defaults, reading without lifting the read direction above the horizon.
     NoHorizonLift,
-    /// The defaults reading the table as `F₀·A + B` (`ShadeOptions::TABLE_F0`).
-    TableF0,
+    /// The defaults with the common ambient weights, `F·A + B` and `1 − F` with the
+    /// roughness-aware Fresnel `F` (`ShadeOptions::ROUGHNESS_FRESNEL`; the default before
+    /// the exact weights).
+    RoughnessFresnel,
     /// The defaults with the shading ladder's `fetches` prefiltered fetches per pixel.
     Ladder,
     /// The Khronos and Bevy targets' levels (roughness `m/(M−1)`, `⌊log₂ size⌋` mips) read
@@ -93,7 +95,7 @@ impl Method {
             Method::SmithSchlickTable => "defaults, Smith-Schlick table",
             Method::LinearMipBlend => "defaults, linear mip blend",
             Method::NoHorizonLift => "defaults, read not lifted above the horizon",
-            Method::TableF0 => "defaults, table read as F0*A + B",
+            Method::RoughnessFresnel => "defaults, roughness-aware Fresnel weights",
             Method::Ladder => "shading ladder",
             Method::KhronosBevyLookup => "khronos/bevy target, engine's trilinear read",
             Method::FilamentLookup => "filament target, engine's trilinear read",

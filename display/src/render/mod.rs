@@ -118,6 +118,7 @@ impl ViewState {
                 (ShadeOptions::FILTERED_SAMPLING, "filtered"),
                 (ShadeOptions::CORRELATED_SMITH, "exact Smith for lights"),
                 (ShadeOptions::LOG_MIP_BLEND, "log mip blend"),
+                (ShadeOptions::ROUGHNESS_FRESNEL, "roughness-aware Fresnel"),
             ]
             .iter()
             .filter(|(bit, _)| flags & bit != 0)

@@ -92,6 +92,10 @@ pub struct MaterialSpec {
     /// Read without lifting the read direction above the horizon (see [`ShadingChoices`]).
     #[serde(default)]
     pub no_horizon_lift: bool,
+    /// The common roughness-aware Fresnel weights instead of the exact ones (see
+    /// [`ShadingChoices`]).
+    #[serde(default)]
+    pub roughness_fresnel: bool,
     /// Prefiltered fetches per pixel of the shading ladder: 1, 2, 4, 8 or 16 (see
     /// [`ShadingChoices`]).
     #[serde(default = "one")]
@@ -131,6 +135,11 @@ pub struct ShadingChoices {
     /// (`shade::above_horizon`).
     #[cfg_attr(feature = "cli", arg(long))]
     pub no_horizon_lift: bool,
+    /// Weight the image-based light with the common roughness-aware Fresnel
+    /// (`F·A + B`, diffuse `1 − F`) instead of the glTF BRDF's exact integrals (`F₀·A + B`,
+    /// diffuse `(1 − 0.04)(1 − C(n·v))`; `shade::ambient_diffuse_weight`).
+    #[cfg_attr(feature = "cli", arg(long))]
+    pub roughness_fresnel: bool,
     /// Prefiltered fetches per pixel: 1 is the split sum; 2, 4, 8 or 16 follow the true
     /// specular lobe at grazing views (the shading ladder, `shade::lobe_radiance`), at that
     /// many fetches' cost. `runner report` measures each rung's error against its cost.
@@ -172,6 +181,7 @@ impl ShadingChoices {
         set(!self.smith_schlick, ShadeOptions::CORRELATED_SMITH);
         set(!self.linear_mip_blend, ShadeOptions::LOG_MIP_BLEND);
         set(!self.no_horizon_lift, ShadeOptions::LIFT_ABOVE_HORIZON);
+        set(self.roughness_fresnel, ShadeOptions::ROUGHNESS_FRESNEL);
         ShadeOptions { flags: f, ..ShadeOptions::DEFAULT }.with_fetches(self.fetches).flags
     }
 }
@@ -206,6 +216,7 @@ impl MaterialSpec {
                 smith_schlick: self.smith_schlick,
                 linear_mip_blend: self.linear_mip_blend,
                 no_horizon_lift: self.no_horizon_lift,
+                roughness_fresnel: self.roughness_fresnel,
                 fetches: self.fetches,
             }
             .flags(self.ibl, true),

@@ -10,20 +10,26 @@
 //! diffuse weight `k_d = (1 − F)(1 − metallic)` (Lambert, Oren–Nayar). The Fresnel-weighted
 //! diffuse carries its own Fresnel factor and is weighted by `1 − metallic` only.
 //!
-//! **Image-based light** (Karis 2013 eq. 8, the split sum; LearnOpenGL "Specular IBL"):
-//! `F = F₀ + (max(1 − r, F₀) − F₀)(1 − n·v)⁵` (or its spherical-Gaussian twin),
-//! `k_d = (1 − F)(1 − metallic)`,
-//! `L_o = (k_d ρ E/π + L̃(r)·(F·A + B))·ao`,
+//! **Image-based light** (Karis 2013 eq. 8, the split sum), with the weights of the glTF
+//! BRDF integrated exactly ([`ambient_diffuse_weight`]):
+//! `L_o = ((1 − metallic)(1 − F₀,d)(1 − C(n·v)) ρ E/π + L̃(r)·(F₀·A + B))·ao`,
 //! with `E/π` the irradiance cube, `L̃` the prefiltered cube at the mip holding roughness
-//! `r` (trilinear), `(A, B)` the BRDF table at `(n·v, r)`. Phong and Blinn–Phong use the
+//! `r` (trilinear), `(A, B)` the BRDF table at `(n·v, r)`, `F₀,d = 0.04` and `C` the
+//! cosine-weighted mean of Schlick's weight ([`fresnel::schlick_weight_hemispherical_mean`]).
+//! Under a constant sky both weights are the BRDF's own integrals, so it shades exactly.
+//! [`ShadeOptions::ROUGHNESS_FRESNEL`] keeps the common form instead (LearnOpenGL
+//! "Specular IBL"): `F = F₀ + (max(1 − r, F₀) − F₀)(1 − n·v)⁵`, `k_d = (1 − F)(1 − metallic)`,
+//! `L_o = (k_d ρ E/π + L̃(r)·(F·A + B))·ao`. Phong and Blinn–Phong use the
 //! prefiltered cube times `F` (the GGX table does not apply to them). Oren–Nayar under the
 //! irradiance is treated as Lambert (a cosine-convolved irradiance has no view dependence to
 //! give it); the Fresnel-weighted diffuse multiplies in its view factor
 //! `1 − (1 − n·v/2)⁵` and the cosine-weighted mean of its light factor,
 //! `2∫₀¹ (1 − (1 − μ/2)⁵) μ dμ = 23/28`, which cancels its `28/23` normalisation.
 //!
-//! Materials follow glTF 2.0's metallic–roughness model: `F₀ = mix(0.04, base, metallic)`,
-//! diffuse albedo `ρ = base·(1 − metallic)`.
+//! Materials follow glTF 2.0's metallic–roughness model (glTF 2.0 specification,
+//! Appendix B): `F₀ = mix(0.04, base, metallic)`, diffuse albedo `ρ = base·(1 − metallic)`,
+//! and the diffuse layer under `fresnel_mix` weighted by `1 − F(v·h)` with the dielectric's
+//! `F₀,d = 0.04` ([`DIELECTRIC_F0`]).
 //!
 //! **Sheen** (`KHR_materials_sheen`, as the glTF Sample Viewer layers it): a Charlie lobe
 //! on top, `L_o = sheen + base·(1 − max(c)·E_C)` ([`sheen_ibl`], [`sheen_direct`]).
@@ -124,11 +130,12 @@ crate::flags!(ShadeOptions, reserved (ShadeOptions::FETCH_MASK) {
     /// Blend the two mips a roughness falls between in log luminance
     /// ([`cubemap::sample_lod_log`]) instead of linearly.
     LOG_MIP_BLEND = 6,
-    /// Read the BRDF table as `F₀·A + B`, its exact meaning (the table integrates Schlick's
-    /// `(1 − v·h)⁵` into `B`), instead of `F·A + B` with the roughness-aware Fresnel `F` of
-    /// [`fresnel_ambient`] (Fdez-Agüera 2019's form, which adds the view's Fresnel a second
-    /// time at grazing views). The diffuse weight `1 − F` is the same in both.
-    TABLE_F0 = 7,
+    /// The common ambient weights instead of the exact ones: the table read as `F·A + B`
+    /// with the roughness-aware Fresnel `F` of [`fresnel_ambient`] (Fdez-Agüera 2019's
+    /// form) and the diffuse weighted by `1 − F`. Both count the view's Fresnel a second time
+    /// at grazing views (the table already integrates `(1 − v·h)⁵` into `B`), so a constant
+    /// sky is not shaded exactly. Off by default: see [`ambient_diffuse_weight`].
+    ROUGHNESS_FRESNEL = 7,
     /// Lift the read direction of the one fetch so that the prefiltered lobe round it
     /// stays above the surface's horizon ([`above_horizon`]).
     LIFT_ABOVE_HORIZON = 11,
@@ -212,7 +219,7 @@ impl Material {
     /// Normal-incidence reflectance `mix(0.04, base, metallic)`.
     #[inline]
     pub fn f0(&self) -> Vec3 {
-        Vec3::splat(0.04).lerp(self.base_color, self.metallic)
+        Vec3::splat(DIELECTRIC_F0).lerp(self.base_color, self.metallic)
     }
 
     /// Diffuse albedo `base·(1 − metallic)`.
@@ -220,6 +227,26 @@ impl Material {
     pub fn albedo(&self) -> Vec3 {
         self.base_color * (1.0 - self.metallic)
     }
+}
+
+/// Normal-incidence reflectance of glTF's dielectric, `((1 − ior)/(1 + ior))²` at
+/// `ior = 1.5` (glTF 2.0 specification, Appendix B.3.4, `fresnel_mix`).
+pub const DIELECTRIC_F0: f32 = 0.04;
+
+/// The exact image-based diffuse weight of the glTF BRDF at `n·v`, per unit of
+/// `(1 − metallic)·base·E/π`: `(1 − F₀,d)(1 − C(n·v))`.
+///
+/// glTF mixes `(1 − metallic)·fresnel_mix(ρ/π, specular) + metallic·conductor(specular)`;
+/// only the dielectric has a diffuse layer, weighted by `1 − F(v·h)` with
+/// `F₀,d = `[`DIELECTRIC_F0`]. Under a constant sky that layer reflects
+/// `(1 − F₀,d)(1 − C(n·v))·ρ·L` ([`fresnel::schlick_weight_hemispherical_mean`]): from
+/// 0.96 at normal incidence to 0.933 at grazing views. The common
+/// `1 − F_roughness(n·v)` falls to 0.43 at `n·v = 0.1` on a smooth dielectric, taking
+/// from the diffuse light the specular never gets.
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
+pub fn ambient_diffuse_weight(n_dot_v: f32) -> f32 {
+    (1.0 - DIELECTRIC_F0) * (1.0 - fresnel::schlick_weight_hemispherical_mean(n_dot_v))
 }
 
 /// Fresnel at `cos_theta` in the chosen form.
@@ -275,7 +302,8 @@ pub fn direct(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, l: Vec3, radia
     let diffuse = if opts.diffuse == DiffuseModel::FresnelWeighted as u32 {
         diffuse::fresnel_weighted(m.base_color, f0, n_dot_l, n_dot_v) * no_metal
     } else {
-        let kd = (Vec3::ONE - f) * no_metal;
+        // glTF's fresnel_mix: the dielectric's own F₀,d, whatever the metalness.
+        let kd = (Vec3::ONE - fresnel(opts.fresnel, Vec3::splat(DIELECTRIC_F0), v_dot_h)) * no_metal;
         if opts.diffuse == DiffuseModel::OrenNayar as u32 {
             kd * diffuse::oren_nayar(m.base_color, m.roughness, n_dot_l, n_dot_v, l.dot(v))
         } else {
@@ -448,14 +476,18 @@ pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4
 pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> Vec3 {
     let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
     let f0 = m.f0();
-    let f = fresnel_ambient(opts.fresnel, f0, n_dot_v, m.roughness);
+    let common = opts.flags & ShadeOptions::ROUGHNESS_FRESNEL != 0;
+    // The Fresnel that scales the table's A: F₀ is its exact meaning.
+    let f_roughness = fresnel_ambient(opts.fresnel, f0, n_dot_v, m.roughness);
+    let f = if common { f_roughness } else { f0 };
     let no_metal = 1.0 - m.metallic;
     let diffuse = if opts.diffuse == DiffuseModel::FresnelWeighted as u32 {
         let view = 1.0 - math::pow5(1.0 - 0.5 * n_dot_v);
         // (28/23)·(23/28): the light factor's cosine-weighted mean cancels the normalisation.
         m.base_color * (Vec3::ONE - f0) * (no_metal * view) * s.irradiance
     } else {
-        (Vec3::ONE - f) * no_metal * m.base_color * s.irradiance
+        let kd = if common { Vec3::ONE - f } else { Vec3::splat(ambient_diffuse_weight(n_dot_v)) };
+        kd * no_metal * m.base_color * s.irradiance
     };
     if opts.specular == SpecularModel::CookTorrance as u32
         && opts.flags & ShadeOptions::MULTISCATTER != 0
@@ -466,12 +498,12 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
         return (kd * m.base_color * s.irradiance + single * s.prefiltered + multiple * s.irradiance) * m.occlusion;
     }
     let specular = if opts.specular == SpecularModel::CookTorrance as u32 {
-        let f_table = if opts.flags & ShadeOptions::TABLE_F0 != 0 { f0 } else { f };
-        s.prefiltered * (f_table * s.brdf.x + Vec3::splat(s.brdf.y))
+        s.prefiltered * (f * s.brdf.x + Vec3::splat(s.brdf.y))
     } else if opts.specular == SpecularModel::None as u32 {
         Vec3::ZERO
     } else {
-        s.prefiltered * f
+        // Phong and Blinn–Phong have no table: the prefiltered light times a Fresnel.
+        s.prefiltered * f_roughness
     };
     (diffuse + specular) * m.occlusion
 }
