@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # splitsum against Mitsuba 3 (scalar_rgb, from PyPI, in a virtual environment under
-# target/): single white-metal spheres (r 0.5, 0.65, 0.8) under every sunny environment of
-# the tuning and the held-out sets, rendered by Mitsuba's path tracer (one bounce: the
+# target/): single white-metal spheres (r 0.3, 0.5, 0.65, 0.8, 1) under every sunny
+# environment of the tuning and the held-out sets (or those named after RES), rendered by Mitsuba's path tracer (one bounce: the
 # exact reflectance integral, estimated), and splitsum's shading of the same pixels at 1, 4
-# and 16 fetches. Prints the table the README quotes. About 15 minutes on 2 cores.
-#   bash scripts/mitsuba.sh [SPP] [RES]
+# and 16 fetches. Prints the table the README quotes. About 25 minutes on 2 cores for all
+# eight environments.
+#   bash scripts/mitsuba.sh [SPP] [RES] [ENVIRONMENT...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # SPLITSUM_DRY_RUN: print the commands instead of running them (as scripts/dev.sh does).
@@ -21,7 +22,7 @@ fi
 OUT=target/mitsuba
 dry || { rm -rf "$OUT" && mkdir -p "$OUT"; }
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
-run bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- envs "$OUT"
+run bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- envs "$OUT" "${@:3}"
 run "$VENV/bin/python" scripts/mitsuba_spheres.py render "$OUT" "$SPP" "$RES" >&2
 run bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- shade "$OUT"
 run "$VENV/bin/python" scripts/mitsuba_spheres.py compare "$OUT"

@@ -1,4 +1,4 @@
-"""Mitsuba 3 renders of single white-metal spheres (F0 = 1: Mitsuba's roughconductor
+"""Mitsuba 3 renders of single white-metal spheres (r 0.3 to 1) (F0 = 1: Mitsuba's roughconductor
 with material 'none', GGX, visible-normal sampling) under each sunny environment that
 `mitsuba_spheres envs DIR` wrote, and their comparison with splitsum's shading of the same
 pixels (`mitsuba_spheres shade DIR`). Run by scripts/mitsuba.sh.
@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROUGHNESS = [0.5, 0.65, 0.8]
+ROUGHNESS = [0.3, 0.5, 0.65, 0.8, 1.0]
 FETCHES = [1, 4, 16]
 # The pixels compared: the sphere's interior, n.v >= 0.15 (at the rim a pixel's footprint
 # spans normals its averaged normal does not stand for).
@@ -123,7 +123,7 @@ def compare(directory):
             cells = [f"{100 * noise.mean():.1f} %"]
             signed = None
             for k in FETCHES:
-                got = luminance(np.fromfile(directory / f"{slug}_r{r}_k{k}.f32", dtype="<f4").reshape(-1, 3))
+                got = luminance(np.fromfile(directory / f"{slug}_r{r:g}_k{k}.f32", dtype="<f4").reshape(-1, 3))
                 rel = np.abs(got - truth) / np.maximum(truth, 1e-6)
                 whole = abs(got.mean() - truth.mean()) / truth.mean()
                 cells.append(f"{100 * rel.mean():.1f} % ({100 * whole:.1f} %)")

@@ -1,8 +1,9 @@
 //! splitsum's side of the comparison with Mitsuba 3 (`scripts/mitsuba.sh`): single spheres
 //! of white metal (F₀ = 1) under the sunny environments of both sets.
 //!
-//! - `envs DIR`: writes each sunny environment of the two sets as `DIR/<slug>.exr` (32-bit
-//!   float, the radiance splitsum reads), and `DIR/envs.txt` (slug, set).
+//! - `envs DIR [NAME...]`: writes each sunny environment of the two sets (or those named)
+//!   as `DIR/<slug>.exr` (32-bit float, the radiance splitsum reads), and `DIR/envs.txt`
+//!   (slug, set).
 //! - `shade DIR`: for every `DIR/<slug>_points.f32` that the script's Mitsuba run wrote
 //!   (per pixel: the normal and the view, six f32), bakes `<slug>.exr` with the defaults
 //!   and writes `DIR/<slug>_r<r>_k<K>.f32`: per pixel the RGB that splitsum's shading gives a
@@ -16,8 +17,8 @@ use splitsum_shaders::glam::Vec3;
 use splitsum_shaders::shade::{self, Material, ShadeOptions};
 use std::path::Path;
 
-/// The roughnesses rendered (the metals at r 0.5–0.8).
-const ROUGHNESS: [f32; 3] = [0.5, 0.65, 0.8];
+/// The roughnesses rendered (rough metals, r 0.3–1).
+const ROUGHNESS: [f32; 5] = [0.3, 0.5, 0.65, 0.8, 1.0];
 /// The ladder's rungs compared.
 const FETCHES: [u32; 3] = [1, 4, 16];
 
@@ -36,7 +37,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     match mode {
         Some("envs") => {
             let mut list = String::new();
-            for m in MEMBERS.iter().filter(|m| sunny(m.source, m.name)) {
+            let named = &args[3..];
+            for m in MEMBERS.iter().filter(|m| sunny(m.source, m.name) && (named.is_empty() || named.iter().any(|n| n == m.name))) {
                 let env = splitsum_report::sets::load(m, envs, 1024)?;
                 let splitsum::environment::Environment::Equirect(e) = &env else { return Err(format!("{} is not an equirect", m.name).into()) };
                 let s = slug(m.name);
