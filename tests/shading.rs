@@ -131,22 +131,3 @@ fn a_sun_below_the_horizon() {
         }
     }
 }
-
-/// The white furnace of multiple scattering (`ShadeOptions::MULTISCATTER`, Fdez-Agüera
-/// 2019): a white metal (`F₀ = 1`) under a constant sky reflects all of it, at every `n·v`
-/// and roughness, with the table's `(A, B)` from the reference's quadrature: the single
-/// scattering `A + B` plus `F_ms·E_ms`, with `F_avg = 1`, is exactly 1. Bound 10⁻⁶: f32
-/// rounding of a handful of operations on values near 1.
-#[test]
-fn multiple_scattering_returns_a_white_furnace_whole() {
-    for nv in [0.05f64, 0.3, 0.7, 1.0] {
-        let (n, v) = frame(nv);
-        for r in [0.1f64, 0.5, 1.0] {
-            let (a, b) = reference::brdf_lut_with(nv, r, 1e-9, Smith::Correlated);
-            let sample = IblSample { prefiltered: Vec3::ONE, irradiance: Vec3::ONE, brdf: Vec2::new(a as f32, b as f32) };
-            let opts = ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::MULTISCATTER, ..ShadeOptions::DEFAULT };
-            let got = shade::ibl(opts, &material(Vec3::ONE, 1.0, r as f32), vec(n), vec(v), sample);
-            assert!((got - Vec3::ONE).abs().max_element() < 1e-6, "n·v {nv}, r {r}: {got} (single scattering {})", a + b);
-        }
-    }
-}
