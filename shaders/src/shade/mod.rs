@@ -477,9 +477,11 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
     let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
     let f0 = m.f0();
     let common = opts.flags & ShadeOptions::ROUGHNESS_FRESNEL != 0;
-    // The Fresnel that scales the table's A: F₀ is its exact meaning.
-    let f_roughness = fresnel_ambient(opts.fresnel, f0, n_dot_v, m.roughness);
-    let f = if common { f_roughness } else { f0 };
+    let cook_torrance = opts.specular == SpecularModel::CookTorrance as u32;
+    // The Fresnel that scales the table's A (F₀ is its exact meaning), or for Phong and
+    // Blinn–Phong, which have no table, the prefiltered light: roughness-aware only where
+    // it is used.
+    let f = if common || !cook_torrance { fresnel_ambient(opts.fresnel, f0, n_dot_v, m.roughness) } else { f0 };
     let no_metal = 1.0 - m.metallic;
     let diffuse = if opts.diffuse == DiffuseModel::FresnelWeighted as u32 {
         let view = 1.0 - math::pow5(1.0 - 0.5 * n_dot_v);
@@ -489,7 +491,7 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
         let kd = if common { Vec3::ONE - f } else { Vec3::splat(ambient_diffuse_weight(n_dot_v)) };
         kd * no_metal * m.base_color * s.irradiance
     };
-    if opts.specular == SpecularModel::CookTorrance as u32
+    if cook_torrance
         && opts.flags & ShadeOptions::MULTISCATTER != 0
         && opts.diffuse != DiffuseModel::FresnelWeighted as u32
     {
@@ -497,13 +499,12 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
         let kd = (Vec3::ONE - single - multiple) * no_metal;
         return (kd * m.base_color * s.irradiance + single * s.prefiltered + multiple * s.irradiance) * m.occlusion;
     }
-    let specular = if opts.specular == SpecularModel::CookTorrance as u32 {
+    let specular = if cook_torrance {
         s.prefiltered * (f * s.brdf.x + Vec3::splat(s.brdf.y))
     } else if opts.specular == SpecularModel::None as u32 {
         Vec3::ZERO
     } else {
-        // Phong and Blinn–Phong have no table: the prefiltered light times a Fresnel.
-        s.prefiltered * f_roughness
+        s.prefiltered * f
     };
     (diffuse + specular) * m.occlusion
 }
