@@ -1,4 +1,4 @@
-"""Mitsuba 3 renders of single white-metal spheres (r 0.3 to 1) (F0 = 1: Mitsuba's roughconductor
+"""Mitsuba 3 renders of single white-metal spheres, r 0.3 to 1 (F0 = 1: Mitsuba's roughconductor
 with material 'none', GGX, visible-normal sampling) under each sunny environment that
 `mitsuba_spheres envs DIR` wrote, and their comparison with splitsum's shading of the same
 pixels (`mitsuba_spheres shade DIR`). Run by scripts/mitsuba.sh.
