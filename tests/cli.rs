@@ -84,8 +84,23 @@ fn lut_writes_exr_and_png() {
     let d = scratch("ok");
     let out = d.join("t.exr");
     let preview = d.join("t.png");
-    cli::run(["runner", "lut", "--size", "16", "--method", "sampled", "--samples", "64", "--backend", "cpu", "--png", preview.to_str().unwrap(), "--out", out.to_str().unwrap()])
-        .expect("bake");
+    cli::run([
+        "runner",
+        "lut",
+        "--size",
+        "16",
+        "--method",
+        "sampled",
+        "--samples",
+        "64",
+        "--backend",
+        "cpu",
+        "--png",
+        preview.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ])
+    .expect("bake");
     let png = image::open(d.join("t.png")).expect("png").to_rgb8();
     assert_eq!(png.dimensions(), (16, 16));
     // Reading the EXR back gives two 32-bit channels with the table's conventions: the

@@ -93,7 +93,9 @@ fn check_runner(args: &[String], said: &str) -> Result<(), String> {
         // The prose names a subcommand or a flag (`runner bench`, `runner bake --budget`):
         // every word given parsed, and only what follows is missing.
         Err(e) if e.kind() == ErrorKind::MissingRequiredArgument => Ok(()),
-        Err(e) if e.kind() == ErrorKind::InvalidValue && args.last().is_some_and(|w| w.starts_with("--")) && e.to_string().contains("a value is required") => Ok(()),
+        Err(e) if e.kind() == ErrorKind::InvalidValue && args.last().is_some_and(|w| w.starts_with("--")) && e.to_string().contains("a value is required") => {
+            Ok(())
+        }
         Err(e) => Err(format!("{said}: runner {}: {}", args.join(" "), e.render())),
     }
 }

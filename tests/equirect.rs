@@ -1,7 +1,7 @@
 //! Equirect conventions and the area-correct resampling to a cube.
 
-use splitsum::Product;
 use splitsum::Backend;
+use splitsum::Product;
 use splitsum::texture::Equirect;
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::equirect::{self, Facing};

@@ -274,7 +274,9 @@ fn the_crate_documentation_example_bakes_on_vulkan_on_gl_and_on_the_cpu() {
     let root = std::env::temp_dir().join(format!("splitsum-app-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&root);
     let mut cubes = Vec::new();
-    for (name, backends, compute) in [("vulkan", wgpu::Backends::VULKAN, Compute::Gpu), ("gl", wgpu::Backends::GL, Compute::Gpu), ("cpu", wgpu::Backends::VULKAN, Compute::Cpu)] {
+    for (name, backends, compute) in
+        [("vulkan", wgpu::Backends::VULKAN, Compute::Gpu), ("gl", wgpu::Backends::GL, Compute::Gpu), ("cpu", wgpu::Backends::VULKAN, Compute::Cpu)]
+    {
         let out = root.join(name);
         let manifest = app::bake(backends, &sky, &out, compute).unwrap_or_else(|e| panic!("{name}: {e}"));
         let mut files: Vec<&str> = manifest.files.iter().map(|f| f.name.as_str()).collect();
@@ -301,8 +303,10 @@ fn the_crate_documentation_example_bakes_on_vulkan_on_gl_and_on_the_cpu() {
 fn a_device_that_cannot_run_the_kernels_is_refused_by_name() {
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor { backends: wgpu::Backends::VULKAN, ..wgpu::InstanceDescriptor::new_without_display_handle() });
     let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default())).expect("an adapter");
-    let (d, q) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor { required_limits: wgpu::Limits::downlevel_webgl2_defaults(), ..Default::default() }))
-        .expect("a device with WebGL2's limits");
+    let (d, q) = pollster::block_on(
+        adapter.request_device(&wgpu::DeviceDescriptor { required_limits: wgpu::Limits::downlevel_webgl2_defaults(), ..Default::default() }),
+    )
+    .expect("a device with WebGL2's limits");
     let e = Baker::new(&d, &q, Compute::Gpu).err().expect("refused").to_string();
     assert!(e.contains("cannot run splitsum's kernels") && e.contains("compute shaders") && e.contains("storage buffers") && e.contains("Compute::Cpu"), "{e}");
     let ibl = Baker::new(&d, &q, Compute::Cpu).unwrap().bake(Source::Environment(&constant(1.0)), &small()).unwrap();
@@ -347,11 +351,15 @@ fn a_bake_in_the_browsers_webgpu_matches_the_cpu() {
     let settings = Settings { size, irradiance_size: 8, lut_size: 32, ..Settings::default() };
     let (d, q) = device();
     let cpu = Baker::new(d, q, Compute::Cpu).unwrap().bake(Source::Environment(&env), &settings).unwrap().read(d, q).map(data).unwrap();
-    let want: Vec<f32> = cpu.specular.texels.iter().chain(&cpu.irradiance.texels).flat_map(|v| v.to_array()).chain(cpu.brdf.iter().flat_map(|t| [t.x, t.y])).collect();
+    let want: Vec<f32> =
+        cpu.specular.texels.iter().chain(&cpu.irradiance.texels).flat_map(|v| v.to_array()).chain(cpu.brdf.iter().flat_map(|t| [t.x, t.y])).collect();
     assert_eq!(got.len(), want.len(), "specular, irradiance and table values");
     let peak = want.iter().copied().fold(0.0f32, f32::max);
     let worst = got.iter().zip(&want).map(|(a, b)| (a - b).abs() / b.abs().max(1e-3 * peak)).fold(0.0f32, f32::max);
-    eprintln!("WebGPU in Chromium against the CPU: largest relative difference {worst:.2e} ({})", std::fs::read_to_string(out.with_extension("bin.txt")).unwrap_or_default());
+    eprintln!(
+        "WebGPU in Chromium against the CPU: largest relative difference {worst:.2e} ({})",
+        std::fs::read_to_string(out.with_extension("bin.txt")).unwrap_or_default()
+    );
     assert!(worst <= 2.0f32.powi(-10), "{worst:.2e}");
     // The GPU process's peak resident memory (sampled by run.mjs): within 2 GiB, where one
     // module holding every kernel took it to 13.9 GB and it exited (issue 33).

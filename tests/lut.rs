@@ -210,5 +210,8 @@ fn embedded_table_is_a_fresh_computation_bit_for_bit() {
     assert_eq!(differ, 0, "{differ} texels of the embedded table differ from a fresh computation: run `bash scripts/dev.sh table`");
     let job = splitsum::Settings::default().resolve(splitsum::InputShape::Unknown, splitsum::Products::ALL).expect("defaults");
     assert_eq!(TableKey::of(&job), TableKey::EMBEDDED, "the defaults no longer read the embedded table");
-    assert!(std::sync::Arc::ptr_eq(&table::texels(TableKey::EMBEDDED).unwrap(), &table::texels(TableKey::EMBEDDED).unwrap()), "the table is decoded once per process");
+    assert!(
+        std::sync::Arc::ptr_eq(&table::texels(TableKey::EMBEDDED).unwrap(), &table::texels(TableKey::EMBEDDED).unwrap()),
+        "the table is decoded once per process"
+    );
 }

@@ -2,8 +2,8 @@
 //! a render from the reduced bake equals the render from a full bake, unchanged bakes come
 //! from the cache, and corrupt or foreign entries are rebuilt, never used.
 
-use splitsum::Product;
 use splitsum::Backend;
+use splitsum::Product;
 use splitsum::bake::BakedEnvironment;
 use splitsum::cache::{Cache, Lookup, Rejection};
 use splitsum::cost::Calibration;
@@ -78,7 +78,10 @@ fn sheen_is_baked_only_where_a_material_has_it() {
     std::fs::create_dir_all(&dir).unwrap();
     let glb = dir.join("velvet.glb");
     std::fs::write(&glb, support::model::sample_glb_with(Some(serde_json::json!({"KHR_materials_sheen": {"sheenColorFactor": [0.5, 0.5, 0.5]}})))).unwrap();
-    let text = format!("[[materials]]\nname = \"m\"\nroughness = \"texture\"\nmetallic = \"texture\"\n\n[[objects]]\nkind = \"gltf\"\npath = {:?}\nmaterial = \"m\"\n", glb.display().to_string());
+    let text = format!(
+        "[[materials]]\nname = \"m\"\nroughness = \"texture\"\nmetallic = \"texture\"\n\n[[objects]]\nkind = \"gltf\"\npath = {:?}\nmaterial = \"m\"\n",
+        glb.display().to_string()
+    );
     let p = planned(&scene("", &text));
     assert!(p.job.products.has(Product::Sheen) && p.job.prefiltered[&Product::Sheen].levels == (0..p.job.mips).collect::<Vec<_>>(), "{:?}", p.decisions);
     let torus = planned(&scene("", &model("m", "roughness = \"texture\"\nmetallic = \"texture\"")));
@@ -95,7 +98,10 @@ fn sheen_is_baked_only_where_a_material_has_it() {
 fn no_specular_image_light_drops_the_prefilter_and_the_table() {
     for fields in ["specular = \"none\"", "specular = \"none\"\ndiffuse = \"oren-nayar\""] {
         let p = planned(&scene("", &material("clay", fields)));
-        assert!(!p.job.products.has(Product::Specular) && !p.job.products.has(Product::BrdfTable) && p.job.products.has(Product::Irradiance), "{fields}: {p:?}");
+        assert!(
+            !p.job.products.has(Product::Specular) && !p.job.products.has(Product::BrdfTable) && p.job.products.has(Product::Irradiance),
+            "{fields}: {p:?}"
+        );
         assert!(p.job.prefiltered[&Product::Specular].levels.is_empty());
         assert!(skipped(&p, Subject::SpecularCube) && skipped(&p, Subject::BrdfTable));
         assert!(p.cost.cpu_seconds < p.full_cost.cpu_seconds);
@@ -173,7 +179,12 @@ fn a_scene_draws_every_object_or_is_refused() {
 fn no_image_light_bakes_nothing() {
     for body in [material("unlit", "ibl = false"), String::new()] {
         let p = planned(&scene("", &body));
-        assert!(!p.job.products.has(Product::Specular) && !p.job.products.has(Product::BrdfTable) && !p.job.products.has(Product::Irradiance) && !p.job.products.has(Product::Sh9));
+        assert!(
+            !p.job.products.has(Product::Specular)
+                && !p.job.products.has(Product::BrdfTable)
+                && !p.job.products.has(Product::Irradiance)
+                && !p.job.products.has(Product::Sh9)
+        );
         assert!(p.job.prefiltered[&Product::Specular].levels.is_empty());
         assert!(skipped(&p, Subject::Everything));
     }
@@ -304,11 +315,17 @@ fn renders_from_reduced_bakes_equal_renders_from_full_bakes() {
     for (name, head, body) in cases {
         let s = scene(&head, &format!("{body}\n{QUICK}\n[[lights]]\nkind = \"directional\"\ndirection = [0.3, 1.0, 0.5]\nradiance = [2.0, 2.0, 2.0]"));
         let (p, reduced, full) = reduced_and_full(&s, &env);
-        let left_out = !(p.job.products.has(Product::Specular) && p.job.products.has(Product::BrdfTable) && p.job.products.has(Product::Irradiance)) || p.job.prefiltered[&Product::Specular].levels.len() < p.job.mips as usize;
+        let left_out = !(p.job.products.has(Product::Specular) && p.job.products.has(Product::BrdfTable) && p.job.products.has(Product::Irradiance))
+            || p.job.prefiltered[&Product::Specular].levels.len() < p.job.mips as usize;
         assert!(left_out, "{name}: the plan should leave something out");
         let cpu = max_abs(&render(&s, &reduced, &Backend::Cpu), &render(&s, &full, &Backend::Cpu));
         let lava = max_abs(&render(&s, &reduced, gpu), &render(&s, &full, gpu));
-        println!("{name}: levels {:?} of {}, products {:?}: reduced vs full, CPU {cpu:e}, GPU {lava:e}", p.job.prefiltered[&Product::Specular].levels, p.job.mips, p.job.products);
+        println!(
+            "{name}: levels {:?} of {}, products {:?}: reduced vs full, CPU {cpu:e}, GPU {lava:e}",
+            p.job.prefiltered[&Product::Specular].levels,
+            p.job.mips,
+            p.job.products
+        );
         assert_eq!(cpu, 0.0, "{name}: the reduced bake changed the CPU render");
         assert!(lava <= 1e-6, "{name}: the reduced bake changed the GPU render by {lava}");
     }
@@ -323,7 +340,10 @@ fn temp(name: &str) -> PathBuf {
 }
 
 fn same(a: &BakedEnvironment, b: &BakedEnvironment) -> bool {
-    a.cube(Product::SourceCube).texels == b.cube(Product::SourceCube).texels && a.cube(Product::Specular).texels == b.cube(Product::Specular).texels && a.cube(Product::Irradiance).texels == b.cube(Product::Irradiance).texels && a.table(Product::BrdfTable).texels == b.table(Product::BrdfTable).texels
+    a.cube(Product::SourceCube).texels == b.cube(Product::SourceCube).texels
+        && a.cube(Product::Specular).texels == b.cube(Product::Specular).texels
+        && a.cube(Product::Irradiance).texels == b.cube(Product::Irradiance).texels
+        && a.table(Product::BrdfTable).texels == b.table(Product::BrdfTable).texels
 }
 
 fn entry_file(dir: &Path, key: &str, name: &str) -> PathBuf {
@@ -574,7 +594,11 @@ fn a_time_budget_picks_the_lowest_predicted_error_that_fits() {
         println!("budget {budget}: {} samples, irradiance {}: {why}", p.job.samples, p.job.irradiance_source);
         assert!(error <= last + 1e-12, "budget {budget}: {error} above the smaller budget's {last}");
         // A choice over the budget is the cheapest measured, and says so.
-        assert!(p.cost.gpu_seconds <= budget || (estimate > budget && why.to_string().contains("cheapest")), "budget {budget}: estimated {} s: {why}", p.cost.gpu_seconds);
+        assert!(
+            p.cost.gpu_seconds <= budget || (estimate > budget && why.to_string().contains("cheapest")),
+            "budget {budget}: estimated {} s: {why}",
+            p.cost.gpu_seconds
+        );
         last = error;
     }
     for (extra, field) in [("max_error = 0.1", "max_error"), ("samples = 64", "samples"), ("irradiance_source = 16", "irradiance_source")] {

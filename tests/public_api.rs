@@ -20,7 +20,9 @@ fn src() -> PathBuf {
 fn left_out(attrs: &[syn::Attribute]) -> bool {
     attrs.iter().any(|a| {
         let text = quote_attr(a);
-        (a.path().is_ident("cfg") && (text.contains("feature =") && !text.contains("not (feature") || text.contains("target_arch = \"wasm32\"") && !text.contains("not (target_arch")))
+        (a.path().is_ident("cfg")
+            && (text.contains("feature =") && !text.contains("not (feature")
+                || text.contains("target_arch = \"wasm32\"") && !text.contains("not (target_arch")))
             || (a.path().is_ident("doc") && text.contains("hidden"))
     })
 }
@@ -187,7 +189,9 @@ fn resolve(all: &BTreeMap<String, Vec<syn::Item>>, module: &str, path: &str) -> 
             std::iter::once(parent).chain(segs[1..].iter().copied()).collect::<Vec<_>>().join("::")
         }
         Some(first) if all.contains_key(&format!("{module}::{first}")) => std::iter::once(module).chain(segs.iter().copied()).collect::<Vec<_>>().join("::"),
-        Some(first) if all.contains_key(&format!("splitsum::{first}")) => std::iter::once("splitsum").chain(segs.iter().copied()).collect::<Vec<_>>().join("::"),
+        Some(first) if all.contains_key(&format!("splitsum::{first}")) => {
+            std::iter::once("splitsum").chain(segs.iter().copied()).collect::<Vec<_>>().join("::")
+        }
         _ => return ("use", None),
     };
     let Some(items) = all.get(&base) else { return ("use", None) };
@@ -246,10 +250,14 @@ fn the_public_api_is_the_committed_list() {
         return;
     }
     let was = std::fs::read_to_string(listed()).unwrap_or_default();
-    let (a, b): (BTreeSet<&str>, BTreeSet<&str>) = (was.lines().filter(|l| !l.starts_with('#')).collect(), now.lines().filter(|l| !l.starts_with('#')).collect());
+    let (a, b): (BTreeSet<&str>, BTreeSet<&str>) =
+        (was.lines().filter(|l| !l.starts_with('#')).collect(), now.lines().filter(|l| !l.starts_with('#')).collect());
     let gone: Vec<_> = a.difference(&b).collect();
     let new: Vec<_> = b.difference(&a).collect();
-    assert!(gone.is_empty() && new.is_empty(), "the public API changed; if on purpose, run with SPLITSUM_BLESS=1 and commit splitsum/public-api.txt\nremoved: {gone:#?}\nadded: {new:#?}");
+    assert!(
+        gone.is_empty() && new.is_empty(),
+        "the public API changed; if on purpose, run with SPLITSUM_BLESS=1 and commit splitsum/public-api.txt\nremoved: {gone:#?}\nadded: {new:#?}"
+    );
 }
 
 #[test]

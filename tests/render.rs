@@ -88,7 +88,11 @@ fn gpu_matches_the_cpu_reference() {
 #[test]
 fn shading_options_gpu_match_the_cpu_reference() {
     let base = ShadeOptions::IBL | ShadeOptions::DIRECT;
-    let all = ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::LIFT_ABOVE_HORIZON | ShadeOptions::MULTISCATTER | ShadeOptions::CORRELATED_SMITH | ShadeOptions::FILTERED_SAMPLING;
+    let all = ShadeOptions::DOMINANT_DIRECTION
+        | ShadeOptions::LIFT_ABOVE_HORIZON
+        | ShadeOptions::MULTISCATTER
+        | ShadeOptions::CORRELATED_SMITH
+        | ShadeOptions::FILTERED_SAMPLING;
     let extras = [
         0,
         ShadeOptions::DOMINANT_DIRECTION,

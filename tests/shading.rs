@@ -66,7 +66,13 @@ fn a_constant_sky_shades_exactly() {
                 let m = material(base, metallic, r as f32);
                 let want = env.shade(n, v, [0.9, 0.6, 0.3], metallic as f64, r, Smith::Correlated);
                 let got = shade::ibl(ShadeOptions::DEFAULT, &m, vec(n), vec(v), sample);
-                let common = shade::ibl(ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::ROUGHNESS_FRESNEL, ..ShadeOptions::DEFAULT }, &m, vec(n), vec(v), sample);
+                let common = shade::ibl(
+                    ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::ROUGHNESS_FRESNEL, ..ShadeOptions::DEFAULT },
+                    &m,
+                    vec(n),
+                    vec(v),
+                    sample,
+                );
                 for c in 0..3 {
                     let e = (got[c] as f64 / want[c] - 1.0).abs();
                     assert!(e < 5e-3, "n·v {nv}, r {r}, metallic {metallic}, channel {c}: {} against the integral {}", got[c], want[c]);

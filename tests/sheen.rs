@@ -4,9 +4,9 @@
 //! constant environment), GPU against CPU, and a bake that leaves sheen out when nothing
 //! reads it. glTF-IBL-Sampler's own Charlie output is compared in `targets.rs`.
 
-use splitsum::Product;
 use rayon::prelude::*;
 use splitsum::Backend;
+use splitsum::Product;
 use splitsum::texture::Cube;
 use splitsum_shaders::cubemap::{self, CubeLayout};
 use splitsum_shaders::glam::{Vec3, Vec4};
@@ -81,7 +81,11 @@ fn sheen_white_furnace() {
 /// ring, traced by 256 samples) included.
 #[test]
 fn sheen_cube_matches_the_exact_integral() {
-    let suns = [(Vec3::new(0.3, 0.5, -0.81), Vec3::new(40.0, 30.0, 20.0)), (Vec3::new(-0.8, 0.05, 0.56), Vec3::new(4.0, 8.0, 12.0)), (Vec3::new(0.2, -0.3, 0.93), Vec3::new(10.0, 6.0, 3.0))];
+    let suns = [
+        (Vec3::new(0.3, 0.5, -0.81), Vec3::new(40.0, 30.0, 20.0)),
+        (Vec3::new(-0.8, 0.05, 0.56), Vec3::new(4.0, 8.0, 12.0)),
+        (Vec3::new(0.2, -0.3, 0.93), Vec3::new(10.0, 6.0, 3.0)),
+    ];
     let sky = |d: Vec3| {
         let t = 0.5 + 0.5 * d.y;
         let mut c = Vec3::new(0.2 + 0.6 * t, 0.3 + 0.6 * t, 0.5 + 0.8 * t);
@@ -99,33 +103,45 @@ fn sheen_cube_matches_the_exact_integral() {
     let probes = |s: u32| -> Vec<(u32, u32, u32)> { (0..6).flat_map(|f| [(s / 2, s / 2), (0, s / 3), (s - 1, s - 1)].map(|(x, y)| (f, x, y))).collect() };
     // The reference at each probe: the exact sum, or at roughness 0 (α → 0: the weight
     // concentrates on the horizon) the mean of the sky round the horizon, by 4096 points.
-    let want: Vec<Vec<f64>> = r
-        .iter()
-        .enumerate()
-        .map(|(m, &rm)| {
-            let s = out.level_size(m as u32);
-            probes(s)
-                .par_iter()
-                .map(|&(f, x, y)| {
-                    let n = cubemap::texel_dir(f, x, y, s);
-                    if rm == 0.0 {
-                        let (t, b) = splitsum_shaders::sampling::orthonormal_basis(n);
-                        (0..4096).map(|k| lum_of(sky((t * (k as f32 / 4096.0 * std::f32::consts::TAU).cos() + b * (k as f32 / 4096.0 * std::f32::consts::TAU).sin()).normalize()))).sum::<f64>() / 4096.0
-                    } else {
-                        lum(reference::sheen::prefilter(&env, [n.x as f64, n.y as f64, n.z as f64], rm as f64))
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let want: Vec<Vec<f64>> =
+        r.iter()
+            .enumerate()
+            .map(|(m, &rm)| {
+                let s = out.level_size(m as u32);
+                probes(s)
+                    .par_iter()
+                    .map(|&(f, x, y)| {
+                        let n = cubemap::texel_dir(f, x, y, s);
+                        if rm == 0.0 {
+                            let (t, b) = splitsum_shaders::sampling::orthonormal_basis(n);
+                            (0..4096)
+                                .map(|k| {
+                                    lum_of(sky((t * (k as f32 / 4096.0 * std::f32::consts::TAU).cos() + b * (k as f32 / 4096.0 * std::f32::consts::TAU).sin())
+                                        .normalize()))
+                                })
+                                .sum::<f64>()
+                                / 4096.0
+                        } else {
+                            lum(reference::sheen::prefilter(&env, [n.x as f64, n.y as f64, n.z as f64], rm as f64))
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
     for b in [&Backend::Cpu, gpu()] {
         let cube = sheen_cube(b, &src, out, 256, true);
         for (m, &rm) in r.iter().enumerate() {
             let s = out.level_size(m as u32);
             let level = cube.level(m as u32);
-            let errors: Vec<f64> = probes(s).iter().zip(&want[m]).map(|(&(f, x, y), w)| (lum_of(level[((f * s + y) * s + x) as usize]) - w).abs() / w).collect();
+            let errors: Vec<f64> =
+                probes(s).iter().zip(&want[m]).map(|(&(f, x, y), w)| (lum_of(level[((f * s + y) * s + x) as usize]) - w).abs() / w).collect();
             let mean = errors.iter().sum::<f64>() / errors.len() as f64;
-            println!("{}: sheen mip {m} (r {rm:.1}): mean relative error {:.3} %, worst {:.3} %", b.describe(), 100.0 * mean, 100.0 * errors.iter().copied().fold(0.0, f64::max));
+            println!(
+                "{}: sheen mip {m} (r {rm:.1}): mean relative error {:.3} %, worst {:.3} %",
+                b.describe(),
+                100.0 * mean,
+                100.0 * errors.iter().copied().fold(0.0, f64::max)
+            );
             assert!(mean < 0.04, "mip {m}: {mean}");
         }
     }
@@ -151,7 +167,6 @@ fn sheen_cube_gpu_matches_cpu() {
         assert!(rel < bound, "{rel:e}");
     }
 }
-
 
 /// The sheen tables the library embeds (`splitsum::table::sheen_texels`, what every bake
 /// with sheen uploads) are a fresh CPU computation (`lut::sheen_texel` on every texel) bit
@@ -207,7 +222,15 @@ fn sheen_shading_under_a_constant_sky_is_the_sheen_albedo() {
             for nv in [1e-4f32, 0.05, 0.3, 0.7, 1.0] {
                 let v = (n * nv + t * (1.0 - nv * nv).max(0.0).sqrt()).normalize();
                 for r in [0.0f32, 0.1, 0.37, 0.8, 1.0] {
-                    let m = Material { base_color: Vec3::ONE, metallic: 0.0, roughness: 0.5, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: colour, sheen_roughness: r };
+                    let m = Material {
+                        base_color: Vec3::ONE,
+                        metallic: 0.0,
+                        roughness: 0.5,
+                        occlusion: 1.0,
+                        emissive: Vec3::ZERO,
+                        sheen_color: colour,
+                        sheen_roughness: r,
+                    };
                     let (layer, keep) = shade::sheen_ibl(shape, &cube.texels, &tables, &m, n, v);
                     assert!(layer.is_finite() && keep.is_finite(), "c {c} n {n} n·v {nv} r {r}: {layer} {keep}");
                     // A bilinear read holds outside the outermost texel centres.
@@ -248,10 +271,14 @@ fn a_sheen_grid_renders_the_same_on_gpu_and_cpu() {
     let frame = view.frame(scene.shape, 96, 64, true);
     let g = scene.render_offscreen(gpu, &frame, None).unwrap();
     let c = render_cpu(&env, &frame);
-    let worst = g.iter().zip(&c).map(|(a, b)| {
-        assert!(a.is_finite() && b.is_finite());
-        (*a - *b).abs().max_element()
-    }).fold(0.0f32, f32::max);
+    let worst = g
+        .iter()
+        .zip(&c)
+        .map(|(a, b)| {
+            assert!(a.is_finite() && b.is_finite());
+            (*a - *b).abs().max_element()
+        })
+        .fold(0.0f32, f32::max);
     // The layout: the grid's rows, then the sheen row, the only one with sheen, its
     // metalness the top row's, its sheen roughness across the columns.
     let f = view.frame(scene.shape, 96, 64, true);

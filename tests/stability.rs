@@ -3,8 +3,8 @@
 //! be finite; the BRDF table stays within [0, 1]; a constant environment stays constant.
 //! `docs/HAZARDS.md` lists each hazard with the rule the code applies.
 
-use splitsum::Product;
 use splitsum::Backend;
+use splitsum::Product;
 use splitsum::texture::Cube;
 use splitsum_shaders::cubemap::CubeLayout;
 use splitsum_shaders::glam::{Vec3, Vec4};
@@ -121,7 +121,15 @@ fn shading_is_finite_at_the_extremes() {
             let v = Vec3::new((1.0 - nv * nv).sqrt(), 0.0, nv);
             for metallic in [0.0f32, 1.0] {
                 for &radiance in &[0.0f32, 1e-40, 1e4, 1e6, MAX_RADIANCE] {
-                    let m = Material { base_color: Vec3::ONE, metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
+                    let m = Material {
+                        base_color: Vec3::ONE,
+                        metallic,
+                        roughness: r,
+                        occlusion: 1.0,
+                        emissive: Vec3::ZERO,
+                        sheen_color: Vec3::ZERO,
+                        sheen_roughness: 0.0,
+                    };
                     for diffuse in 0..(<shade::DiffuseModel as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
                         for specular in 0..(<shade::SpecularModel as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
                             for fresnel in 0..(<shade::FresnelForm as splitsum_shaders::choice::Choice>::ALL.len() as u32) {
@@ -190,7 +198,15 @@ fn the_shading_ladder_keeps_a_constant_sky_constant() {
                 let v = (n * nv + t * (1.0 - nv * nv).sqrt()).normalize();
                 for &r in &ROUGHNESS {
                     for metallic in [0.0f32, 1.0] {
-                        let m = Material { base_color: Vec3::new(0.9, 0.5, 0.2), metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
+                        let m = Material {
+                            base_color: Vec3::new(0.9, 0.5, 0.2),
+                            metallic,
+                            roughness: r,
+                            occlusion: 1.0,
+                            emissive: Vec3::ZERO,
+                            sheen_color: Vec3::ZERO,
+                            sheen_roughness: 0.0,
+                        };
                         for fetches in [2, 4, 8, 16] {
                             let opts = ShadeOptions::DEFAULT.with_fetches(fetches);
                             assert_eq!(opts.fetches(), fetches);

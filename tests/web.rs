@@ -64,7 +64,8 @@ fn the_web_page_shows_and_downloads_what_the_command_line_makes() {
     let sky = dir.join("sky.hdr");
     sunny_sky(&sky);
     let cpu = dir.join("cpu.png");
-    let args = ["runner", "render", sky.to_str().unwrap(), "--backend", "cpu", "--no-model", "--width", "640", "--height", "360", "--out", cpu.to_str().unwrap()];
+    let args =
+        ["runner", "render", sky.to_str().unwrap(), "--backend", "cpu", "--no-model", "--width", "640", "--height", "360", "--out", cpu.to_str().unwrap()];
     runner::cli::run(args.map(String::from)).unwrap();
     let want = image::open(&cpu).unwrap().to_rgb8();
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("webgpu/page.mjs");

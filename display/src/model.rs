@@ -202,7 +202,9 @@ fn import(path: &Path, bytes: &[u8], base: Option<&Path>) -> Result<(gltf::Docum
     for buffer in document.buffers() {
         let length = buffer.length();
         let mut data = match buffer.source() {
-            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| Error::file(path, format!("buffer {} names a binary chunk the file lacks", buffer.index())))?,
+            gltf::buffer::Source::Bin => {
+                blob.take().ok_or_else(|| Error::file(path, format!("buffer {} names a binary chunk the file lacks", buffer.index())))?
+            }
             gltf::buffer::Source::Uri(uri) => read_uri(path, base, uri, Some(length as u64))?,
         };
         if data.len() < length {
@@ -223,7 +225,13 @@ fn import(path: &Path, bytes: &[u8], base: Option<&Path>) -> Result<(gltf::Docum
             if need > view.length() as u64 {
                 return Err(Error::file(
                     path,
-                    format!("accessor {} claims {} elements, which take {need} bytes, but its bufferView {} holds {}", a.index(), a.count(), view.index(), view.length()),
+                    format!(
+                        "accessor {} claims {} elements, which take {need} bytes, but its bufferView {} holds {}",
+                        a.index(),
+                        a.count(),
+                        view.index(),
+                        view.length()
+                    ),
                 ));
             }
         }
@@ -233,7 +241,9 @@ fn import(path: &Path, bytes: &[u8], base: Option<&Path>) -> Result<(gltf::Docum
         let (encoded, mime) = match image.source() {
             gltf::image::Source::View { view, mime_type } => {
                 let data = &buffers.get(view.buffer().index()).ok_or_else(|| Error::file(path, format!("image {} names a missing buffer", image.index())))?.0;
-                let bytes = data.get(view.offset()..view.offset() + view.length()).ok_or_else(|| Error::file(path, format!("image {}'s bufferView runs past its buffer", image.index())))?;
+                let bytes = data
+                    .get(view.offset()..view.offset() + view.length())
+                    .ok_or_else(|| Error::file(path, format!("image {}'s bufferView runs past its buffer", image.index())))?;
                 (std::borrow::Cow::Borrowed(bytes), Some(mime_type))
             }
             gltf::image::Source::Uri { uri, mime_type } => (std::borrow::Cow::Owned(read_uri(path, base, uri, None)?), mime_type),
@@ -455,7 +465,9 @@ fn primitive(
     let sheen_texture = |key: &str| -> Result<Option<gltf::texture::Texture>> {
         match sheen.and_then(|e| e.get(key)).map(|t| t.get("index").and_then(serde_json::Value::as_u64)) {
             None => Ok(None),
-            Some(Some(i)) => doc.textures().nth(i as usize).map(Some).ok_or_else(|| Error::file(path, format!("{SHEEN}: {key} names texture {i}, which does not exist"))),
+            Some(Some(i)) => {
+                doc.textures().nth(i as usize).map(Some).ok_or_else(|| Error::file(path, format!("{SHEEN}: {key} names texture {i}, which does not exist")))
+            }
             Some(None) => Err(Error::file(path, format!("{SHEEN}: {key} has no texture index"))),
         }
     };
@@ -463,8 +475,14 @@ fn primitive(
         match sheen.and_then(|e| e.get(key)) {
             None => Ok(vec![default; n]),
             Some(v) => {
-                let values: Option<Vec<f32>> = if n == 1 { v.as_f64().map(|x| vec![x as f32]) } else { v.as_array().map(|a| a.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect()) };
-                values.filter(|v| v.len() == n && v.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x))).ok_or_else(|| Error::file(path, format!("{SHEEN}: {key} must be {n} number(s) in [0, 1], not {v}")))
+                let values: Option<Vec<f32>> = if n == 1 {
+                    v.as_f64().map(|x| vec![x as f32])
+                } else {
+                    v.as_array().map(|a| a.iter().filter_map(|x| x.as_f64().map(|x| x as f32)).collect())
+                };
+                values
+                    .filter(|v| v.len() == n && v.iter().all(|x| x.is_finite() && (0.0..=1.0).contains(x)))
+                    .ok_or_else(|| Error::file(path, format!("{SHEEN}: {key} must be {n} number(s) in [0, 1], not {v}")))
             }
         }
     };

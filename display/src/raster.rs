@@ -4,9 +4,9 @@
 //! texture filtering (bilinear, repeat, mip 0; sRGB decoded before filtering), then the
 //! same `surface::material` and `scene::shade_point` the fragment shader runs.
 
-use splitsum::Product;
 use crate::model::{Model, Texture};
 use rayon::prelude::*;
+use splitsum::Product;
 use splitsum::bake::BakedEnvironment;
 use splitsum_shaders::glam::{Vec2, Vec3, Vec4};
 use splitsum_shaders::scene::{self, Frame};
@@ -83,7 +83,16 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
     colour.par_chunks_mut(w).zip(depth.par_chunks_mut(w)).enumerate().for_each(|(y, (crow, drow))| {
         for x in 0..w {
             let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            let (c, d) = scene::radiance_depth(frame, env.cube(Product::SourceCube).level(0), &env.cube(Product::Specular).texels, &env.cube(Product::Irradiance).texels, &env.table(Product::BrdfTable).texels, &env.cube(Product::Sheen).texels, &env.table(Product::SheenTables).texels, px);
+            let (c, d) = scene::radiance_depth(
+                frame,
+                env.cube(Product::SourceCube).level(0),
+                &env.cube(Product::Specular).texels,
+                &env.cube(Product::Irradiance).texels,
+                &env.table(Product::BrdfTable).texels,
+                &env.cube(Product::Sheen).texels,
+                &env.table(Product::SheenTables).texels,
+                px,
+            );
             crow[x] = c;
             drow[x] = d;
         }

@@ -60,13 +60,30 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let raw: Vec<f32> = std::fs::read(&points)?.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
                 let shape = baked.shape();
                 for &r in &ROUGHNESS {
-                    let m = Material { base_color: Vec3::ONE, metallic: 1.0, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
+                    let m = Material {
+                        base_color: Vec3::ONE,
+                        metallic: 1.0,
+                        roughness: r,
+                        occlusion: 1.0,
+                        emissive: Vec3::ZERO,
+                        sheen_color: Vec3::ZERO,
+                        sheen_roughness: 0.0,
+                    };
                     for &k in &FETCHES {
                         let opts = ShadeOptions { flags: ShadeOptions::DEFAULT.flags & !ShadeOptions::DIRECT, ..ShadeOptions::DEFAULT }.with_fetches(k);
                         let mut out = Vec::with_capacity(raw.len() / 2);
                         for p in raw.chunks_exact(6) {
                             let (n, v) = (Vec3::new(p[0], p[1], p[2]), Vec3::new(p[3], p[4], p[5]));
-                            let sample = shade::ibl_sample(shape, &baked.cube(Product::Specular).texels, &baked.cube(Product::Irradiance).texels, &baked.table(Product::BrdfTable).texels, opts, &m, n, v);
+                            let sample = shade::ibl_sample(
+                                shape,
+                                &baked.cube(Product::Specular).texels,
+                                &baked.cube(Product::Irradiance).texels,
+                                &baked.table(Product::BrdfTable).texels,
+                                opts,
+                                &m,
+                                n,
+                                v,
+                            );
                             let c = shade::ibl(opts, &m, n, v, sample);
                             out.extend([c.x, c.y, c.z]);
                         }

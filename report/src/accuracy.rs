@@ -24,9 +24,9 @@
 //! - (c) *model*: the full integral with the method's masking term against the truth
 //!   (Smith–Schlick against exact Smith).
 
-use splitsum::Product;
 use crate::measurement::{Knob, Measurement, Method as Kind, Metric, Part, Quantity, arr, rel, rel64};
 use rayon::prelude::*;
+use splitsum::Product;
 use splitsum::backend::Backend;
 use splitsum::bake;
 use splitsum::environment::Environment;
@@ -95,7 +95,8 @@ struct ShadingPoint {
 }
 
 /// The read-direction flags of [`ShadingPoint::prefiltered`]'s entries.
-const READ_FLAGS: [u32; 4] = [0, ShadeOptions::DOMINANT_DIRECTION, ShadeOptions::LIFT_ABOVE_HORIZON, ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::LIFT_ABOVE_HORIZON];
+const READ_FLAGS: [u32; 4] =
+    [0, ShadeOptions::DOMINANT_DIRECTION, ShadeOptions::LIFT_ABOVE_HORIZON, ShadeOptions::DOMINANT_DIRECTION | ShadeOptions::LIFT_ABOVE_HORIZON];
 
 /// The entry of [`ShadingPoint::prefiltered`] that shading with `flags` reads along: the
 /// one whose read-direction flags are those of `flags`.
@@ -183,7 +184,15 @@ impl Points {
                     (n, (n * nv + tangent(n, turn) * (1.0 - nv * nv).sqrt()).normalize())
                 }
             };
-            let material = Material { base_color: base, metallic: (i % 2) as f32, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
+            let material = Material {
+                base_color: base,
+                metallic: (i % 2) as f32,
+                roughness: r,
+                occlusion: 1.0,
+                emissive: Vec3::ZERO,
+                sheen_color: Vec3::ZERO,
+                sheen_roughness: 0.0,
+            };
             pts.push((material, n, v));
         }
         let shading: Vec<ShadingPoint> = pts

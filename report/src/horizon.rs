@@ -79,10 +79,8 @@ pub fn measure(backend: &Backend, width: u32, radiance: f32, size: u32) -> Resul
         let baked = bake::bake_for_display(backend, env, &settings)?;
         let source = baked.cube(Product::SourceCube);
         let refenv = reference::Environment::new(source.level(0), source.layout.size);
-        let truth: Vec<[f64; 3]> = pts
-            .par_iter()
-            .map(|&(n, v, r)| refenv.shade(arr(n), arr(v), arr(base), 1.0, r as f64, reference::Smith::Correlated))
-            .collect();
+        let truth: Vec<[f64; 3]> =
+            pts.par_iter().map(|&(n, v, r)| refenv.shade(arr(n), arr(v), arr(base), 1.0, r as f64, reference::Smith::Correlated)).collect();
         scenes.push((baked, truth));
     }
     for rung in 0..shade::LADDER_RUNGS {
@@ -92,7 +90,15 @@ pub fn measure(backend: &Backend, width: u32, radiance: f32, size: u32) -> Resul
             pts.iter()
                 .zip(truth)
                 .map(|(&(n, v, r), t)| {
-                    let m = Material { base_color: base, metallic: 1.0, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
+                    let m = Material {
+                        base_color: base,
+                        metallic: 1.0,
+                        roughness: r,
+                        occlusion: 1.0,
+                        emissive: Vec3::ZERO,
+                        sheen_color: Vec3::ZERO,
+                        sheen_roughness: 0.0,
+                    };
                     let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, opts, &m, n, v);
                     let got = shade::ibl(opts, &m, n, v, s);
                     rel(got, *t)

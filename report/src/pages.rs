@@ -5,8 +5,8 @@
 //! [`crate::surface`]). Measuring is [`crate::report`]'s.
 
 use crate::measurement::{Knob, Measurement, Method, Part, Quantity};
-use crate::sweep::Sweep;
 use crate::surface::ErrorMap;
+use crate::sweep::Sweep;
 use splitsum::backend::Backend;
 use splitsum::error::Result;
 use splitsum::files;
@@ -193,7 +193,8 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
         .map(|&(env, set)| {
             let of = |m: Key| set_rows.iter().copied().filter(move |r| r.environment == env && key(r) == m);
             let shaded = |m, part: Part| over_environments(of(m).filter(|r| r.product == Quantity::ShadedColour && r.part == part && no_band(r)));
-            let view = |hi: f32| over_environments(of(defaults).filter(|r| r.product == Quantity::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
+            let view =
+                |hi: f32| over_environments(of(defaults).filter(|r| r.product == Quantity::ShadedColour && r.part == Part::Total && r.nv_hi == Some(hi)));
             [
                 env.to_string(),
                 set.title().to_string(),
@@ -232,7 +233,9 @@ fn rungs(rows: &[Measurement]) -> Vec<u32> {
 
 /// The cost per shaded pixel of `method` with `fetches` on the backend `engine`.
 fn cost_of(rows: &[Measurement], method: Method, fetches: u32, engine: &str) -> Option<f64> {
-    rows.iter().find(|r| r.product == Quantity::ShadingCost && r.method == method && r.fetches == Some(fetches) && r.backend == engine).and_then(|r| r.ns_per_pixel)
+    rows.iter()
+        .find(|r| r.product == Quantity::ShadingCost && r.method == method && r.fetches == Some(fetches) && r.backend == engine)
+        .and_then(|r| r.ns_per_pixel)
 }
 
 /// The shaded colour's rows of `method` with `fetches` at the default sample count, part
@@ -274,8 +277,11 @@ fn ladder_table(rows: &[Measurement]) -> Option<Table> {
         .into_iter()
         .map(|(label, method, k)| {
             let cost = |engine: &str| cost_of(rows, method, k, engine).map_or("-".into(), |ns| format!("{ns:.0}"));
-            let own = |band: Option<f32>| over_environments(method_rows(rows, method, k).filter(|r| r.set.is_none() && Some(&r.backend) == first.as_ref() && r.nv_hi == band));
-            let set = |s: crate::measurement::Set, band: Option<f32>| over_environments(method_rows(rows, method, k).filter(|r| r.set == Some(s) && r.nv_hi == band));
+            let own = |band: Option<f32>| {
+                over_environments(method_rows(rows, method, k).filter(|r| r.set.is_none() && Some(&r.backend) == first.as_ref() && r.nv_hi == band))
+            };
+            let set =
+                |s: crate::measurement::Set, band: Option<f32>| over_environments(method_rows(rows, method, k).filter(|r| r.set == Some(s) && r.nv_hi == band));
             [
                 label,
                 cost("gpu"),
@@ -314,7 +320,10 @@ pub fn ladder_panels(rows: &[Measurement]) -> Vec<crate::plot::LadderPanel> {
             let points: Vec<(f64, f64, u32)> = rungs
                 .iter()
                 .filter_map(|&k| {
-                    let errs: Vec<f64> = rung_rows(rows, k).filter(|r| r.set == set && r.nv_hi == band && (set.is_some() || r.backend == engine)).map(|r| r.mean_error).collect();
+                    let errs: Vec<f64> = rung_rows(rows, k)
+                        .filter(|r| r.set == set && r.nv_hi == band && (set.is_some() || r.backend == engine))
+                        .map(|r| r.mean_error)
+                        .collect();
                     (!errs.is_empty()).then(|| Some((ns(k)?, errs.iter().sum::<f64>() / errs.len() as f64, k)))?
                 })
                 .collect();
@@ -350,7 +359,9 @@ fn budget_rows(rows: &[Measurement], band: Option<f32>) -> impl Iterator<Item = 
 fn budget_table(rows: &[Measurement]) -> Option<Table> {
     let cells: Vec<[String; 8]> = budget_rows(rows, None)
         .map(|r| {
-            let grazing = budget_rows(rows, Some(0.1)).find(|g| g.backend == r.backend && g.budget_s == r.budget_s).map_or("-".into(), |g| format!("{:.1} %", 100.0 * g.mean_error));
+            let grazing = budget_rows(rows, Some(0.1))
+                .find(|g| g.backend == r.backend && g.budget_s == r.budget_s)
+                .map_or("-".into(), |g| format!("{:.1} %", 100.0 * g.mean_error));
             [
                 r.backend.clone(),
                 format!("{}", r.budget_s.unwrap_or(f64::NAN)),
@@ -445,7 +456,10 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
         let _ = writeln!(md, "| {} | ![]({}) | ![]({}) | ![]({}) |", caption(what, map), picture(k, "splitsum"), picture(k, "exact"), picture(k, "error"));
     }
     let _ = writeln!(md, "\n![scale](surface_scale.svg)");
-    let figures = [(&ladder, LADDER_NOTE, "ladder", "the shading ladder", "error against ns per shaded pixel, one point per rung"), (&budget, BUDGET_NOTE, "budget", "the budget curve", "error against the time budget, one point per budget")];
+    let figures = [
+        (&ladder, LADDER_NOTE, "ladder", "the shading ladder", "error against ns per shaded pixel, one point per rung"),
+        (&budget, BUDGET_NOTE, "budget", "the budget curve", "error against the time budget, one point per budget"),
+    ];
     for (table, note, id, alt, _) in figures {
         if let Some((title, header, cells)) = table {
             let _ = writeln!(md, "\n## {title}\n\n{note}\n\n![{alt}]({id}.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
@@ -463,7 +477,10 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
             let _ = writeln!(md, "| {} |", c.join(" | "));
         }
     }
-    let _ = writeln!(md, "\n## Best error per millisecond (smallest mean error x time)\n\n| panel | backend | setting | time (ms) | mean error |\n|---|---|---|---:|---:|");
+    let _ = writeln!(
+        md,
+        "\n## Best error per millisecond (smallest mean error x time)\n\n| panel | backend | setting | time (ms) | mean error |\n|---|---|---|---:|---:|"
+    );
     for (p, r) in &best {
         let _ = writeln!(md, "| {p} | {} | {} | {:.1} | {:.2e} |", r.backend, r.setting(), r.time_ms.unwrap_or(f64::NAN), r.mean_error);
     }
@@ -477,7 +494,10 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
         html_escape(name)
     );
     let _ = writeln!(html, "<h1>splitsum: error against run time</h1>\n<p>{}</p>\n<p>{}</p>", html_escape(&setup), html_escape(references));
-    let _ = writeln!(html, "<figure id=\"error-vs-time\"><img src=\"error_vs_time.svg\" alt=\"error against run time, one panel per product\"><figcaption>Mean relative error against bake time, one panel per product: one colour per method, the GPU solid and the CPU dashed; ringed points are each panel's Pareto front.</figcaption></figure>");
+    let _ = writeln!(
+        html,
+        "<figure id=\"error-vs-time\"><img src=\"error_vs_time.svg\" alt=\"error against run time, one panel per product\"><figcaption>Mean relative error against bake time, one panel per product: one colour per method, the GPU solid and the CPU dashed; ringed points are each panel's Pareto front.</figcaption></figure>"
+    );
     let _ = writeln!(html, "<h2>The error on surfaces</h2>\n<p>{}</p>", html_escape(&grid));
     for (k, (what, map)) in maps.iter().enumerate() {
         let _ = writeln!(
@@ -509,15 +529,31 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
         let _ = writeln!(html, "<h2>Tuning and held-out sets</h2>\n<p>{}</p>", html_escape(SETS_NOTE));
     }
     for (title, header, cells) in set_tables.iter().chain(&tables) {
-        let _ = writeln!(html, "<h2>{}</h2>\n<table><tr>{}</tr>", html_escape(title), header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>());
+        let _ = writeln!(
+            html,
+            "<h2>{}</h2>\n<table><tr>{}</tr>",
+            html_escape(title),
+            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
+        );
         for c in cells {
             let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
         }
         let _ = writeln!(html, "</table>");
     }
-    let _ = writeln!(html, "<h2>Best error per millisecond</h2>\n<table><tr><th>panel</th><th>backend</th><th>setting</th><th>time (ms)</th><th>mean error</th></tr>");
+    let _ = writeln!(
+        html,
+        "<h2>Best error per millisecond</h2>\n<table><tr><th>panel</th><th>backend</th><th>setting</th><th>time (ms)</th><th>mean error</th></tr>"
+    );
     for (p, r) in &best {
-        let _ = writeln!(html, "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.2e}</td></tr>", html_escape(p), r.backend, html_escape(&r.setting()), r.time_ms.unwrap_or(f64::NAN), r.mean_error);
+        let _ = writeln!(
+            html,
+            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.2e}</td></tr>",
+            html_escape(p),
+            r.backend,
+            html_escape(&r.setting()),
+            r.time_ms.unwrap_or(f64::NAN),
+            r.mean_error
+        );
     }
     let _ = writeln!(html, "</table></body></html>");
     files::write_atomic(&dir.join("report.html"), |w| std::io::Write::write_all(w, html.as_bytes()))?;

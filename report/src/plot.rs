@@ -225,8 +225,12 @@ pub fn ladder(panels: &[LadderPanel]) -> Result<String, Error> {
                 .draw()?;
             for (i, curve) in panel.curves.iter().enumerate() {
                 let c = PALETTE[i % PALETTE.len()];
-                let pts: Vec<(f64, f64)> = curve.points.iter().map(|p| (p.0, p.1)).filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite()).collect();
-                chart.draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))?.label(curve.label.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
+                let pts: Vec<(f64, f64)> =
+                    curve.points.iter().map(|p| (p.0, p.1)).filter(|(x, y)| *x > 0.0 && *y > 0.0 && x.is_finite() && y.is_finite()).collect();
+                chart
+                    .draw_series(LineSeries::new(pts.clone(), c.stroke_width(2)))?
+                    .label(curve.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2)));
                 chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, c.filled())))?;
                 chart.draw_series(
                     curve.points.iter().filter(|p| p.0 > 0.0 && p.1 > 0.0).map(|&(x, y, k)| Text::new(format!("{k}"), (x, y), ("sans-serif", 11).into_font())),

@@ -15,11 +15,11 @@
 //! repository), `report.csv` (the typed rows, `splitsum::measured`), `error_vs_time.svg`
 //! (small multiples, [`crate::plot`]) and the error on surfaces ([`crate::surface`]).
 
-use splitsum::Product;
+use crate::measurement::{Device, Knob, Measurement, Method, Metric, Part, Quantity, arr, rel};
 use crate::pages::write_outputs;
 use crate::sweep::{Sets, Sweep};
-use crate::measurement::{Device, Knob, Measurement, Method, Metric, Part, Quantity, arr, rel};
 use rayon::prelude::*;
+use splitsum::Product;
 use splitsum::backend::Backend;
 use splitsum::bake;
 use splitsum::environment::Environment;
@@ -53,7 +53,15 @@ fn directions(n: u32) -> Vec<Vec3> {
 /// given, on the first backend), writes the files into `dir` with the shading ladder's
 /// `costs` (`Quantity::ShadingCost` rows, timed by the renderer's owner) beside its errors,
 /// and returns the measurements.
-pub fn run(env: &Environment, name: &str, backends: &[Backend], sweep: &Sweep, sets: Option<&Sets>, costs: &[Measurement], dir: &Path) -> Result<Vec<Measurement>> {
+pub fn run(
+    env: &Environment,
+    name: &str,
+    backends: &[Backend],
+    sweep: &Sweep,
+    sets: Option<&Sets>,
+    costs: &[Measurement],
+    dir: &Path,
+) -> Result<Vec<Measurement>> {
     if let Some(s) = sets
         && !s.present_only
     {
@@ -198,7 +206,15 @@ impl References {
                         let (t, b) = sampling::orthonormal_basis(n);
                         let side = if k % 2 == 0 { t } else { b };
                         let v = (n * nv + side * (1.0 - nv * nv).sqrt()).normalize();
-                        let material = Material { base_color: Vec3::new(0.9, 0.6, 0.3), metallic, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
+                        let material = Material {
+                            base_color: Vec3::new(0.9, 0.6, 0.3),
+                            metallic,
+                            roughness: r,
+                            occlusion: 1.0,
+                            emissive: Vec3::ZERO,
+                            sheen_color: Vec3::ZERO,
+                            sheen_roughness: 0.0,
+                        };
                         shading.push(ShadingPoint { material, n, v, full: [0.0; 3], exact_split: Vec3::ZERO });
                     }
                 }
@@ -252,7 +268,13 @@ fn lut_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References) -> 
     for &n in &sweep.samples {
         let (table, ms) = timed(|| backend.brdf_lut(sweep.lut_size, n))?;
         let errors = albedo_errors(table.texels.iter().copied(), refs.lut.iter().copied());
-        rows.push(Measurement { knob: Knob::Samples, samples: Some(n), size, time_ms: Some(ms), ..b.row(Quantity::BrdfTable, Method::Seed, &errors, Metric::RelativeAlbedo) });
+        rows.push(Measurement {
+            knob: Knob::Samples,
+            samples: Some(n),
+            size,
+            time_ms: Some(ms),
+            ..b.row(Quantity::BrdfTable, Method::Seed, &errors, Metric::RelativeAlbedo)
+        });
     }
     // The deterministic quadrature (the default table), on the same texels.
     let (table, ms) = timed(|| backend.brdf_table(sweep.lut_size, Masking::SmithSchlick))?;
@@ -356,4 +378,3 @@ fn shaded_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, 
     }
     Ok(rows)
 }
-

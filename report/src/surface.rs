@@ -7,9 +7,9 @@
 //! Orthographic view along −z (`v = +z` everywhere), so the rim of each sphere is its
 //! grazing view: the split sum's own error shows there.
 
-use splitsum::Product;
 use crate::measurement::{arr, rel};
 use rayon::prelude::*;
+use splitsum::Product;
 use splitsum::bake::BakedEnvironment;
 use splitsum_reference as reference;
 use splitsum_shaders::glam::Vec3;
@@ -76,7 +76,15 @@ pub fn error_map(baked: &BakedEnvironment, env: &reference::Environment) -> Erro
     let mut points = Vec::new();
     for row in 0..rows {
         for (col, &r) in ROUGHNESS.iter().enumerate() {
-            let material = Material { base_color: Vec3::new(0.9, 0.6, 0.3), metallic: 1.0 - row as f32, roughness: r, occlusion: 1.0, emissive: Vec3::ZERO, sheen_color: Vec3::ZERO, sheen_roughness: 0.0 };
+            let material = Material {
+                base_color: Vec3::new(0.9, 0.6, 0.3),
+                metallic: 1.0 - row as f32,
+                roughness: r,
+                occlusion: 1.0,
+                emissive: Vec3::ZERO,
+                sheen_color: Vec3::ZERO,
+                sheen_roughness: 0.0,
+            };
             for y in 0..d {
                 for x in 0..d {
                     let (px, py) = ((x as f32 + 0.5) / RADIUS as f32 - 1.0, 1.0 - (y as f32 + 0.5) / RADIUS as f32);
@@ -95,7 +103,16 @@ pub fn error_map(baked: &BakedEnvironment, env: &reference::Environment) -> Erro
     let shaded: Vec<(Vec3, [f64; 3])> = points
         .par_iter()
         .map(|(_, _, m, n)| {
-            let s = shade::ibl_sample(shape, &baked.cube(Product::Specular).texels, &baked.cube(Product::Irradiance).texels, &baked.table(Product::BrdfTable).texels, opts, m, *n, v);
+            let s = shade::ibl_sample(
+                shape,
+                &baked.cube(Product::Specular).texels,
+                &baked.cube(Product::Irradiance).texels,
+                &baked.table(Product::BrdfTable).texels,
+                opts,
+                m,
+                *n,
+                v,
+            );
             let got = shade::ibl(opts, m, *n, v, s);
             let want = env.shade(arr(*n), arr(v), arr(m.base_color), m.metallic as f64, m.roughness as f64, reference::Smith::Correlated);
             (got, want)

@@ -143,16 +143,16 @@ impl Sweep {
     ) -> Self {
         let mips = 4;
         let level = |n: u32, lut: u32, irr: u32| Settings {
-                size: specular_size,
-                source_size: Some(source_size),
-                mips: Some(mips),
-                samples: n,
-                irradiance_size: (specular_size / 2).max(4),
-                irradiance_source: Some(irr.min(source_size)),
-                sh_source: Some(source_size),
-                lut_size: lut,
-                lut_samples: n,
-                ..Settings::default()
+            size: specular_size,
+            source_size: Some(source_size),
+            mips: Some(mips),
+            samples: n,
+            irradiance_size: (specular_size / 2).max(4),
+            irradiance_source: Some(irr.min(source_size)),
+            sh_source: Some(source_size),
+            lut_size: lut,
+            lut_samples: n,
+            ..Settings::default()
         };
         let q = &samples;
         let qualities = vec![

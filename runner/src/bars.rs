@@ -56,7 +56,9 @@ impl Terminal {
                 if !loops.contains_key(what) {
                     let bar = self.multi.add(ProgressBar::new(len));
                     bar.set_style(
-                        ProgressStyle::with_template("{prefix:>14} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})").expect("valid template").progress_chars("=> "),
+                        ProgressStyle::with_template("{prefix:>14} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta})")
+                            .expect("valid template")
+                            .progress_chars("=> "),
                     );
                     bar.set_prefix(what.to_string());
                     loops.insert(what.to_string(), bar);

@@ -38,15 +38,16 @@ fn a_budget_counts_start_up_and_calibration_and_holds_at_load() {
     let _load = Load::start(2);
     let budget = 4.0;
     let start = std::time::Instant::now();
-    let o = runner()
-        .args(["bake", &courtyard(), "--backend", "cpu", "--budget", &budget.to_string(), "--out", d.join("out").to_str().unwrap()])
-        .output()
-        .unwrap();
+    let o =
+        runner().args(["bake", &courtyard(), "--backend", "cpu", "--budget", &budget.to_string(), "--out", d.join("out").to_str().unwrap()]).output().unwrap();
     let wall = start.elapsed().as_secs_f64();
     let said = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     assert!(o.status.success(), "{said}");
     let line = said.lines().find(|l| l.starts_with(&format!("budget {budget} s on "))).unwrap_or_else(|| panic!("no budget line:\n{said}"));
-    assert!(line.contains("went to starting the device, reading the input and measuring its rates") && line.contains("writing the files comes after"), "{line}");
+    assert!(
+        line.contains("went to starting the device, reading the input and measuring its rates") && line.contains("writing the files comes after"),
+        "{line}"
+    );
     println!("{line}\nwhole run at load 4: {wall:.2} s");
     assert!(wall <= 2.0 * budget + 1.0, "the run took {wall:.2} s for a {budget} s budget:\n{said}");
 }

@@ -175,7 +175,10 @@ fn tamper(folder: &Path, root: &Path, how: Tampering) -> bool {
         Tampering::LinkToFolder => {
             let name = free("dir");
             std::os::unix::fs::symlink(root.join("outside"), folder.join(&name)).unwrap();
-            add_entries(folder, vec![serde_json::json!({ "path": name.clone() }), serde_json::json!({ "path": format!("{name}/v.txt"), "file": stamp(&outside_bytes) })]);
+            add_entries(
+                folder,
+                vec![serde_json::json!({ "path": name.clone() }), serde_json::json!({ "path": format!("{name}/v.txt"), "file": stamp(&outside_bytes) })],
+            );
         }
         Tampering::HardLink => {
             let name = free("hard");
@@ -210,8 +213,8 @@ fn op_args(op: &Op, env: &Path, scene: &Path, folders: &[PathBuf]) -> Vec<String
 /// its manifest lists every entry there, every listed entry is there, and every file has
 /// the listed size and BLAKE3 hash.
 fn whole_new_set(dir: &Path) -> Result<(), String> {
-    let manifest: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join(MANIFEST)).map_err(|e| format!("no manifest: {e}"))?)
-        .map_err(|e| format!("manifest: {e}"))?;
+    let manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join(MANIFEST)).map_err(|e| format!("no manifest: {e}"))?).map_err(|e| format!("manifest: {e}"))?;
     let mut listed = std::collections::BTreeSet::new();
     for e in manifest["entries"].as_array().ok_or("no entries")? {
         let rel = e["path"].as_str().ok_or("entry without a path")?;
@@ -297,7 +300,9 @@ fn the_users_files_survive_any_sequence_of_runs() {
         // The user's files: beside the output folders always (the victims forged manifests
         // name among them), inside them where a folder starts so.
         let mut mine: std::collections::BTreeMap<PathBuf, Vec<u8>> = Default::default();
-        for (p, bytes) in [(root.join("thesis.tex"), b"mine".to_vec()), (root.join("victim.txt"), b"precious".to_vec()), (root.join("outside/v.txt"), b"also mine".to_vec())] {
+        for (p, bytes) in
+            [(root.join("thesis.tex"), b"mine".to_vec()), (root.join("victim.txt"), b"precious".to_vec()), (root.join("outside/v.txt"), b"also mine".to_vec())]
+        {
             std::fs::write(&p, &bytes).unwrap();
             mine.insert(p, bytes);
         }
@@ -367,7 +372,13 @@ fn the_users_files_survive_any_sequence_of_runs() {
                 }
             }
             if refused[folder] {
-                prop_assert!(code == Some(2) || (signal.is_some() && code.is_none()) || code == Some(130), "{:?} into a folder of the user's or forged: {:?}: {}", op, code, said);
+                prop_assert!(
+                    code == Some(2) || (signal.is_some() && code.is_none()) || code == Some(130),
+                    "{:?} into a folder of the user's or forged: {:?}: {}",
+                    op,
+                    code,
+                    said
+                );
             } else if signal.is_none() {
                 prop_assert_eq!(code, Some(0), "{:?}: {}", op, said);
             }

@@ -32,8 +32,7 @@ pub fn bake(backends: wgpu::Backends, sky: &Path, out: &Path, compute: Compute) 
     // 1. The application's own device, on any API wgpu has here.
     let instance = wgpu::Instance::new(wgpu::InstanceDescriptor { backends, ..wgpu::InstanceDescriptor::new_without_display_handle() });
     let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))?;
-    let (device, queue) =
-        pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor { required_limits: adapter.limits(), ..Default::default() }))?;
+    let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor { required_limits: adapter.limits(), ..Default::default() }))?;
 
     // 2. The bake, on that device. Settings left at their defaults derive from the size
     //    (mips, source size) and the target.

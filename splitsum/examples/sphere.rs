@@ -206,7 +206,10 @@ fn main() -> splitsum::Result<()> {
     let seconds = start.elapsed().as_secs_f64();
     // Reinhard and sRGB-ish gamma for a look; the pixels themselves are linear radiance.
     let rgb: Vec<u8> = picture.pixels.iter().flat_map(|p| [p[0], p[1], p[2]].map(|c| ((c / (1.0 + c)).powf(1.0 / 2.2) * 255.0).round() as u8)).collect();
-    image::RgbImage::from_raw(picture.size, picture.size, rgb).expect("size² pixels").save(&out).map_err(|e| splitsum::Error::Invalid(format!("{out}: {e}")))?;
+    image::RgbImage::from_raw(picture.size, picture.size, rgb)
+        .expect("size² pixels")
+        .save(&out)
+        .map_err(|e| splitsum::Error::Invalid(format!("{out}: {e}")))?;
     println!("baked on {compute:?} and drew {out} in {seconds:.2} s (pipelines, bake, draw and the picture's readback)");
     Ok(())
 }

@@ -3,8 +3,8 @@
 //! named and encoded as its own baker writes them (`engine_files`); and always
 //! `bake.json` (what was baked, how, from what, and how long it took).
 
-use crate::bake::{Baked, Timing};
 use crate::adjustment::Adjustment;
+use crate::bake::{Baked, Timing};
 use crate::environment::InputReport;
 use crate::error::Result;
 use crate::files::{self, Sink};
@@ -229,9 +229,8 @@ type FileJob<'a> = Box<dyn FnOnce() -> Result<Vec<OutputFile>> + Send + 'a>;
 /// of the BRDF table), the source cube as a preview; previews at `exposure`.
 fn splitsum_files<'a>(p: Product, sink: &'a dyn Sink, baked: &'a Baked, job: &'a Job, exposure: f32) -> Vec<FileJob<'a>> {
     let file = |name: &str, what: String, written: Option<ktx2::Written>| OutputFile { name: name.to_string(), what, written };
-    let save_png = move |name: &str, pic: &preview::Picture| -> Result<()> {
-        put_png(sink, name, pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces))
-    };
+    let save_png =
+        move |name: &str, pic: &preview::Picture| -> Result<()> { put_png(sink, name, pic.width, pic.height, &pic.to_rgb8(exposure, Tonemapper::Aces)) };
     let mut jobs: Vec<FileJob<'a>> = Vec::new();
     if p.lobe().is_some() {
         let Some(cube) = baked.cube(p) else { return jobs };
@@ -241,7 +240,11 @@ fn splitsum_files<'a>(p: Product, sink: &'a dyn Sink, baked: &'a Baked, job: &'a
             let name = format!("{key}.ktx2");
             let w = put_ktx2(sink, &name, cube, job.format, Supercompression::None)?;
             report_clamp(&name, &w);
-            Ok(vec![file(&name, format!("{}, one roughness per mip ({} mapping: settings.prefiltered.{key}.roughness_per_mip)", p.about(), mapping.name()), Some(w))])
+            Ok(vec![file(
+                &name,
+                format!("{}, one roughness per mip ({} mapping: settings.prefiltered.{key}.roughness_per_mip)", p.about(), mapping.name()),
+                Some(w),
+            )])
         }));
         if p == Product::Specular {
             for m in 0..cube.layout.levels {

@@ -159,4 +159,3 @@ impl Format {
 pub(crate) fn max_value(cube: &Cube) -> f32 {
     cube.texels.iter().map(|t| t.x.max(t.y).max(t.z).max(t.w)).fold(0.0, f32::max)
 }
-

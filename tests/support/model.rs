@@ -172,7 +172,8 @@ pub fn sample_glb_with(extensions: Option<serde_json::Value>) -> Vec<u8> {
         "buffers": [{"byteLength": bin.len()}]
     });
     if let Some(ext) = extensions {
-        json["extensionsUsed"] = serde_json::Value::Array(ext.as_object().expect("extensions by name").keys().map(|k| serde_json::Value::String(k.clone())).collect());
+        json["extensionsUsed"] =
+            serde_json::Value::Array(ext.as_object().expect("extensions by name").keys().map(|k| serde_json::Value::String(k.clone())).collect());
         json["materials"][0]["extensions"] = ext;
     }
     glb(&json, &bin)

@@ -148,7 +148,7 @@ fn khronos_target_matches_gltf_ibl_sampler() {
     assert!(es < ek, "splitsum's error {es} is not below glTF-IBL-Sampler's {ek}");
 
     // Sheen: glTF-IBL-Sampler's Charlie cube (`-distribution Charlie`, its 1024 samples)
-    // against splitsum's `charlie/sheen.ktx2` from the bake above: same size, faces and mip
+    // against splitsum's `charlie/sheen.ktx2` (a bake with `--sheen`): same size, faces and mip
     // count, sheen roughness m/(mips − 1) per mip (lib.cpp, as for GGX); per mip the median
     // difference, and the mean error of each against the exact Charlie-weighted sum
     // (`reference::sheen::prefilter` over the sky averaged to a 64² cube; at sheen roughness
@@ -157,12 +157,35 @@ fn khronos_target_matches_gltf_ibl_sampler() {
     // integral where they differ more.
     let kcharlie = d.join("k_sheen.ktx2");
     let t = std::time::Instant::now();
-    run(&["-inputPath", env.to_str().unwrap(), "-outCubeMap", kcharlie.to_str().unwrap(), "-distribution", "Charlie", "-cubeMapResolution", "128", "-sampleCount", "1024"]);
-    println!("glTF-IBL-Sampler's Charlie run: {:.2} s (the three products: {:.2} s; splitsum's bake of all of them above: {splitsum_seconds:.2} s)", t.elapsed().as_secs_f64(), khronos_seconds + t.elapsed().as_secs_f64());
+    run(&[
+        "-inputPath",
+        env.to_str().unwrap(),
+        "-outCubeMap",
+        kcharlie.to_str().unwrap(),
+        "-distribution",
+        "Charlie",
+        "-cubeMapResolution",
+        "128",
+        "-sampleCount",
+        "1024",
+    ]);
+    let charlie_seconds = t.elapsed().as_secs_f64();
+    // The sheen products only with `--sheen` (the full glTF-Sample-Environments layout).
+    let with_sheen = d.join("splitsum_sheen");
+    let t = std::time::Instant::now();
+    bake(&env, &with_sheen, "khronos", &["--size", "128", "--lut-size", "128", "--irradiance-size", "32", "--sheen"]);
+    println!(
+        "glTF-IBL-Sampler's Charlie run: {charlie_seconds:.2} s (GGX and Lambertian {khronos_seconds:.2} s, splitsum without sheen {splitsum_seconds:.2} s; the three runs {:.2} s, splitsum --sheen {:.2} s)",
+        khronos_seconds + charlie_seconds,
+        t.elapsed().as_secs_f64()
+    );
+    assert!(!out.join("charlie").exists(), "khronos without --sheen wrote charlie/");
     let kc = read_ktx2(&kcharlie);
-    let sc = read_ktx2(&out.join("charlie/sheen.ktx2"));
+    let sc = read_ktx2(&with_sheen.join("charlie/sheen.ktx2"));
     assert_eq!((sc.size, sc.faces, sc.levels.len()), (kc.size, kc.faces, kc.levels.len()), "sheen: same size, faces and mip count");
-    let sheen_r: Vec<f64> = manifest["settings"]["prefiltered"]["sheen"]["roughness_per_mip"].as_array().unwrap().iter().map(|r| r.as_f64().unwrap()).collect();
+    let sheen_manifest: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(with_sheen.join("bake.json")).unwrap()).unwrap();
+    let sheen_r: Vec<f64> =
+        sheen_manifest["settings"]["prefiltered"]["sheen"]["roughness_per_mip"].as_array().unwrap().iter().map(|r| r.as_f64().unwrap()).collect();
     let half: Vec<splitsum_shaders::glam::Vec4> = (0..6u32)
         .flat_map(|f| (0..64u32).flat_map(move |y| (0..64u32).map(move |x| (f, x, y))))
         .map(|(f, x, y)| (0..4).map(|k| cube[((f * s + 2 * y + k / 2) * s + 2 * x + k % 2) as usize]).sum::<splitsum_shaders::glam::Vec4>() * 0.25)
@@ -174,7 +197,8 @@ fn khronos_target_matches_gltf_ibl_sampler() {
         let size = s >> m;
         let med = median(sc.levels[m].iter().zip(&kc.levels[m]).map(|(a, b)| rel(*a, *b)).collect());
         let step = (size / 8).max(1);
-        let probes: Vec<(u32, u32, u32)> = (0..6).flat_map(|f| (0..size).step_by(step as usize).flat_map(move |y| (0..size).step_by(step as usize).map(move |x| (f, x, y)))).collect();
+        let probes: Vec<(u32, u32, u32)> =
+            (0..6).flat_map(|f| (0..size).step_by(step as usize).flat_map(move |y| (0..size).step_by(step as usize).map(move |x| (f, x, y)))).collect();
         use rayon::prelude::*;
         let want: Vec<f64> = probes
             .par_iter()
@@ -196,7 +220,10 @@ fn khronos_target_matches_gltf_ibl_sampler() {
                 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
             })
             .collect();
-        let err = |level: &[[f32; 4]]| probes.iter().zip(&want).map(|(&(f, x, y), w)| (luminance(level[((f * size + y) * size + x) as usize]) - w).abs() / w).sum::<f64>() / probes.len() as f64;
+        let err = |level: &[[f32; 4]]| {
+            probes.iter().zip(&want).map(|(&(f, x, y), w)| (luminance(level[((f * size + y) * size + x) as usize]) - w).abs() / w).sum::<f64>()
+                / probes.len() as f64
+        };
         let (e_s, e_k) = (err(&sc.levels[m]), err(&kc.levels[m]));
         println!(
             "sheen mip {m} (sheen roughness {r:.3}): median difference {:.2} %; mean error against the exact integral: splitsum {:.2} %, glTF-IBL-Sampler {:.2} %",

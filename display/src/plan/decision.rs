@@ -209,10 +209,15 @@ impl std::fmt::Display for Cause {
             Cause::Sh9Unread => f.write_str("the display reads the irradiance cube; SH9 is for `runner bake ENV`"),
             Cause::Budget { samples, irradiance_source, error, estimate, budget } => {
                 let fits = if estimate <= budget { "fits" } else { "is the cheapest measured, over" };
-                write!(f, "{samples} samples, irradiance from {irradiance_source}²: predicted error {error:.2e}, estimated {estimate:.2} s on lavapipe ({fits} {budget} s)")
+                write!(
+                    f,
+                    "{samples} samples, irradiance from {irradiance_source}²: predicted error {error:.2e}, estimated {estimate:.2} s on lavapipe ({fits} {budget} s)"
+                )
             }
             Cause::Cheapest { setting, error, target } => write!(f, "{setting}: the cheapest measured, mean error {error:.2e} ≤ {target}"),
-            Cause::MostAccurate { setting, error, target } => write!(f, "{setting}: the most accurate measured; its mean error {error:.2e} is still above {target}"),
+            Cause::MostAccurate { setting, error, target } => {
+                write!(f, "{setting}: the most accurate measured; its mean error {error:.2e} is still above {target}")
+            }
             Cause::Quadrature { target } => write!(f, "quadrature: max error 1e-5 at every texel ≤ {target}"),
         }
     }

@@ -23,13 +23,12 @@
 
 use crate::scene::{MaterialSpec, Scene};
 use serde::Serialize;
-use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum::cost::{Calibration, Cost};
-use splitsum::estimate::built_in_cost;
 use splitsum::error::Result;
+use splitsum::estimate::built_in_cost;
 use splitsum::settings::{InputShape, Job, Product, Products, Settings, TableMethod};
+use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::shade::SpecularModel;
-
 
 mod decision;
 pub use decision::{Cause, Decision, Mip, Setting, Subject};
@@ -89,7 +88,8 @@ pub fn plan(scene: &Scene, native: u32, shape: InputShape, cal: &Calibration) ->
     if !uses.lit.is_empty() {
         d.push(Decision { subject: Subject::Sh9, kept: false, cause: Cause::Sh9Unread });
     }
-    let products = Products::of(&[]).with(Product::Specular, specular).with(Product::Irradiance, irradiance).with(Product::BrdfTable, lut).with(Product::Sheen, sheen);
+    let products =
+        Products::of(&[]).with(Product::Specular, specular).with(Product::Irradiance, irradiance).with(Product::BrdfTable, lut).with(Product::Sheen, sheen);
 
     // Samples, bias, table, irradiance source.
     let q = &scene.quality;
@@ -252,7 +252,9 @@ fn irradiance_cube(uses: &Uses<'_>, d: &mut Vec<Decision>) -> bool {
 /// roughness comes from the file, factors and textures).
 fn sheen(scene: &Scene, uses: &Uses<'_>, mips: u32, d: &mut Vec<Decision>) -> Result<Vec<u32>> {
     let model_sheen = match scene.model_path() {
-        Some(path) if uses.lit.iter().any(|m| scene.objects.iter().any(|o| matches!(o, crate::scene::ObjectSpec::Gltf { material, .. } if *material == m.name))) => {
+        Some(path)
+            if uses.lit.iter().any(|m| scene.objects.iter().any(|o| matches!(o, crate::scene::ObjectSpec::Gltf { material, .. } if *material == m.name))) =>
+        {
             crate::model::uses_sheen(&path)?.then_some(path)
         }
         _ => None,
@@ -276,8 +278,19 @@ fn sheen(scene: &Scene, uses: &Uses<'_>, mips: u32, d: &mut Vec<Decision>) -> Re
 
 /// A time budget: the lowest predicted error over the roughness the scene reads that fits
 /// (estimated on lavapipe's built-in rates, for the levels the plan keeps).
-fn time_budget(settings: &mut Settings, shape: InputShape, products: Products, budget: f64, cal: &Calibration, needed_r: &[f32], levels: &[u32], d: &mut Vec<Decision>) -> Result<()> {
-    let seconds = |job: &splitsum::Job| job.clone().with_levels(Product::Specular, levels.to_vec()).map_or(f64::INFINITY, |j| splitsum::estimate::step_seconds(&j, true).total());
+fn time_budget(
+    settings: &mut Settings,
+    shape: InputShape,
+    products: Products,
+    budget: f64,
+    cal: &Calibration,
+    needed_r: &[f32],
+    levels: &[u32],
+    d: &mut Vec<Decision>,
+) -> Result<()> {
+    let seconds = |job: &splitsum::Job| {
+        job.clone().with_levels(Product::Specular, levels.to_vec()).map_or(f64::INFINITY, |j| splitsum::estimate::step_seconds(&j, true).total())
+    };
     let (chosen, error, estimate) = splitsum::cost::for_budget_by(settings, shape, products, budget, cal, Some(needed_r), seconds)?;
     let cause = Cause::Budget { samples: chosen.samples, irradiance_source: chosen.irradiance_source.unwrap_or_default(), error, estimate, budget };
     d.push(Decision { subject: Subject::TimeBudget, kept: true, cause });
@@ -292,7 +305,8 @@ fn prefilter_samples(q: &crate::scene::QualitySpec, specular: bool, cal: &Calibr
     match (q.samples, q.max_error) {
         (Some(n), _) => Some(n),
         (None, Some(e)) if specular => {
-            let table: Vec<(u32, f64)> = cal.prefilter[0].1.iter().map(|&(n, _)| (n, needed_r.iter().map(|&r| cal.prefilter_error(r, n)).fold(0.0, f64::max))).collect();
+            let table: Vec<(u32, f64)> =
+                cal.prefilter[0].1.iter().map(|&(n, _)| (n, needed_r.iter().map(|&r| cal.prefilter_error(r, n)).fold(0.0, f64::max))).collect();
             let (n, cause) = cheapest(&table, e, Setting::Samples);
             d.push(Decision { subject: Subject::PrefilterSamples, kept: true, cause });
             Some(n)

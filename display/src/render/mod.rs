@@ -5,9 +5,9 @@
 mod meshes;
 pub use meshes::{DEPTH_FORMAT, DEPTH_RANGE, GpuModel, GpuPrimitive};
 
-use splitsum::Product;
 use crate::model::Model;
 use rayon::prelude::*;
+use splitsum::Product;
 use splitsum::backend::gpu::{Gpu, group_entries, group_layout};
 use splitsum::bake::BakedEnvironment;
 use splitsum::error::{Error, Result};
@@ -189,7 +189,8 @@ impl ViewState {
             lights,
             // Right-handed, depth in [0, 1] (`surface::depth` assumes it): view-space
             // `z = −near` maps to 0 and `−far` to 1.
-            view_proj: rh::proj::directx::perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1) * rh::view::look_to_mat4(eye, forward, up),
+            view_proj: rh::proj::directx::perspective(self.fov, width as f32 / height as f32, DEPTH_RANGE.0, DEPTH_RANGE.1)
+                * rh::view::look_to_mat4(eye, forward, up),
             grid_ranges: self.grid_ranges,
             sheen_color: self.sheen_color.extend(0.0),
             sheen_ranges: Vec4::new(self.sheen_ranges.0, self.sheen_ranges.1, 0.0, 0.0),
@@ -265,7 +266,16 @@ pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
     out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
         for (x, p) in row.iter_mut().enumerate() {
             let px = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
-            *p = scene::pixel(frame, env.cube(Product::SourceCube).level(0), &env.cube(Product::Specular).texels, &env.cube(Product::Irradiance).texels, &env.table(Product::BrdfTable).texels, &env.cube(Product::Sheen).texels, &env.table(Product::SheenTables).texels, px);
+            *p = scene::pixel(
+                frame,
+                env.cube(Product::SourceCube).level(0),
+                &env.cube(Product::Specular).texels,
+                &env.cube(Product::Irradiance).texels,
+                &env.table(Product::BrdfTable).texels,
+                &env.cube(Product::Sheen).texels,
+                &env.table(Product::SheenTables).texels,
+                px,
+            );
         }
     });
     out

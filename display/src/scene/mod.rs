@@ -118,9 +118,10 @@ impl Scene {
             }
             for (what, p) in [("metallic", &m.metallic), ("roughness", &m.roughness)] {
                 if let Param::Texture(t) = p
-                    && t != "texture" {
-                        return Err(Problem::NotAParameter { material: m.name.clone(), key: what, text: t.clone() });
-                    }
+                    && t != "texture"
+                {
+                    return Err(Problem::NotAParameter { material: m.name.clone(), key: what, text: t.clone() });
+                }
                 let (a, b) = p.range();
                 if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a > b {
                     return Err(Problem::Range { material: m.name.clone(), key: what, range: (a, b) });
@@ -148,14 +149,19 @@ impl Scene {
             return Err(Problem::FieldOfView(self.camera.fov));
         }
         if let Some(e) = self.quality.max_error
-            && !(e > 0.0) {
-                return Err(Problem::MaxError(e));
-            }
+            && !(e > 0.0)
+        {
+            return Err(Problem::MaxError(e));
+        }
         if let Some(b) = self.quality.max_seconds {
             if !(b > 0.0 && b.is_finite()) {
                 return Err(Problem::MaxSeconds(b));
             }
-            for (set, field) in [(self.quality.max_error.is_some(), "max_error"), (self.quality.samples.is_some(), "samples"), (self.quality.irradiance_source.is_some(), "irradiance_source")] {
+            for (set, field) in [
+                (self.quality.max_error.is_some(), "max_error"),
+                (self.quality.samples.is_some(), "samples"),
+                (self.quality.irradiance_source.is_some(), "irradiance_source"),
+            ] {
                 if set {
                     return Err(Problem::BudgetAndSetting(field));
                 }

@@ -35,9 +35,10 @@ pub(super) struct BakeArgs {
     #[arg(long)]
     sanitize: bool,
     /// Also bake the sheen products (`KHR_materials_sheen`): the Charlie-prefiltered cube
-    /// and the sheen tables (`sheen.ktx2`, `sheen_tables.exr`). The khronos target always
-    /// writes them (`charlie/sheen.ktx2`, `lut_charlie.png`, `lut_sheen_E.png`); bevy and
-    /// filament have no sheen files.
+    /// and the sheen tables (`sheen.ktx2`, `sheen_tables.exr`; for the khronos target
+    /// `charlie/sheen.ktx2`, `lut_charlie.png` and `lut_sheen_E.png`, the full
+    /// glTF-Sample-Environments layout). Only materials with sheen read them; a --scene
+    /// bakes them when one of its materials has sheen. bevy and filament have no sheen files.
     #[arg(long)]
     sheen: bool,
 }
@@ -154,7 +155,8 @@ fn within_budget(
     let estimator = splitsum::estimate::for_backend(backend)?;
     let spent = started.elapsed().as_secs_f64();
     let left = budget - spent;
-    let (chosen, error, seconds) = splitsum::estimate::for_budget(settings, shape, products, left.max(0.0), &estimator, &splitsum::cost::Calibration::default())?;
+    let (chosen, error, seconds) =
+        splitsum::estimate::for_budget(settings, shape, products, left.max(0.0), &estimator, &splitsum::cost::Calibration::default())?;
     let within = estimator.steps(&chosen.resolve(shape, products)?).iter().map(|(_, e)| e.within).fold(0.0, f64::max);
     let fits = if seconds <= left { "fits" } else { "is the cheapest, and still over" };
     println!(
@@ -214,12 +216,22 @@ fn batch_command(args: BakeArgs, given: &[String]) -> anyhow::Result<()> {
         let about = output::About { environment: path.display().to_string(), backend: backend.describe(), input: Some(b.input) };
         let manifest = write_bake(out, &b.baked, &b.job, about)?;
         let bake: f64 = manifest.timings.iter().map(|t| t.seconds).sum();
-        println!("  {}: baked in {bake:.3} s, {} files in {}", path.display(), manifest.files.len() + 1, args.out.join(path.file_stem().unwrap_or_default()).display());
+        println!(
+            "  {}: baked in {bake:.3} s, {} files in {}",
+            path.display(),
+            manifest.files.len() + 1,
+            args.out.join(path.file_stem().unwrap_or_default()).display()
+        );
         Ok(())
     })?;
     let failed: Vec<String> = results.iter().zip(&args.env).filter_map(|(r, p)| r.as_ref().err().map(|e| format!("{}: {e:#}", p.display()))).collect();
     let done = args.env.len() - failed.len();
-    println!("{done} of {} environments baked in {:.2} s ({:.3} s each)", args.env.len(), start.elapsed().as_secs_f64(), start.elapsed().as_secs_f64() / done.max(1) as f64);
+    println!(
+        "{done} of {} environments baked in {:.2} s ({:.3} s each)",
+        args.env.len(),
+        start.elapsed().as_secs_f64(),
+        start.elapsed().as_secs_f64() / done.max(1) as f64
+    );
     if !failed.is_empty() {
         return Err(anyhow::anyhow!("{} of {} environments failed (the others are written):\n  {}", failed.len(), args.env.len(), failed.join("\n  ")));
     }

@@ -117,7 +117,8 @@ pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
             println!("  {:>9} {:>8} {:>11} {:>10} {:>11} {:>10}", "budget s", "samples", "irradiance", "error", "estimate s", "bake s");
             for &budget in &args.budgets {
                 let estimator = splitsum::estimate::for_backend(&backend)?;
-                let (chosen, error, estimate) = splitsum::estimate::for_budget(&settings, InputShape::of(&env), products, budget, &estimator, &splitsum::cost::Calibration::default())?;
+                let (chosen, error, estimate) =
+                    splitsum::estimate::for_budget(&settings, InputShape::of(&env), products, budget, &estimator, &splitsum::cost::Calibration::default())?;
                 let job = chosen.resolve(InputShape::of(&env), products)?;
                 let seconds: f64 = bake::bake_job(&backend, &env, &job)?.timings.iter().map(|t| t.seconds).sum();
                 println!("  {budget:>9} {:>8} {:>10}² {:>9.1} % {estimate:>11.3} {seconds:>10.3}", chosen.samples, job.irradiance_source, 100.0 * error);

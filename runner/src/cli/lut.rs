@@ -44,7 +44,9 @@ pub(super) fn lut(args: LutArgs, given: &[String]) -> anyhow::Result<()> {
     if let Some(p) = &png {
         files::check_output_file(p, files::FileKind::Png, "--png")?;
         if same_file(p, &args.out) {
-            return Err(Usage::new(format!("--png {} and --out {} name the same file: give the preview a name of its own", p.display(), args.out.display())).into());
+            return Err(
+                Usage::new(format!("--png {} and --out {} name the same file: give the preview a name of its own", p.display(), args.out.display())).into()
+            );
         }
     }
     // The table's flags, named as this command names them.

@@ -532,4 +532,3 @@ pub fn load_environment(path: Option<&std::path::Path>, sanitize: bool) -> anyho
         None => Ok((environment::embedded_default()?, "the embedded courtyard (CC0)".to_string())),
     }
 }
-

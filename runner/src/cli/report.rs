@@ -67,7 +67,8 @@ fn ladder_costs(env: &environment::Environment, backends: &[Backend], quick: boo
         let baked = crate::bake::bake_for_display(backend, env, &crate::settings::Settings { size, ..crate::settings::Settings::default() })?;
         let device = splitsum_report::measurement::Device::of(backend);
         // The rungs, and the quality mode below mip 1 (`--filtered`) for its cost beside them.
-        let filtered = (Method::FilteredSampling, 1, ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::FILTERED_SAMPLING, ..ShadeOptions::DEFAULT });
+        let filtered =
+            (Method::FilteredSampling, 1, ShadeOptions { flags: ShadeOptions::DEFAULT.flags | ShadeOptions::FILTERED_SAMPLING, ..ShadeOptions::DEFAULT });
         let rungs = (0..LADDER_RUNGS).map(|rung| {
             let fetches = 1 << rung;
             (splitsum_report::pages::rung_method(fetches), fetches, ShadeOptions::DEFAULT.with_fetches(fetches))

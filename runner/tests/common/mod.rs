@@ -53,4 +53,3 @@ pub fn snapshot(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 pub fn snapshot_or_none(dir: &Path) -> Option<Vec<(PathBuf, Vec<u8>)>> {
     dir.is_dir().then(|| snapshot(dir))
 }
-

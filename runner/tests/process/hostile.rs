@@ -228,7 +228,12 @@ fn hostile_headers_stay_within_memory_bounds() {
     m["files"]["specular.bin"]["bytes"] = serde_json::json!(1u64 << 30);
     std::fs::write(&manifest, serde_json::to_vec(&m).unwrap()).unwrap();
     let (ok, said, peak) = run_measured(scene_bake(), &d);
-    eprintln!("cache entry of 1 GiB: peak {:.1} MiB (first bake {:.1} MiB): {}", peak as f64 / 1048576.0, scene_baseline as f64 / 1048576.0, said.lines().last().unwrap_or(""));
+    eprintln!(
+        "cache entry of 1 GiB: peak {:.1} MiB (first bake {:.1} MiB): {}",
+        peak as f64 / 1048576.0,
+        scene_baseline as f64 / 1048576.0,
+        said.lines().last().unwrap_or("")
+    );
     assert!(ok && said.contains("rejected (specular.bin is corrupt (its BLAKE3 hash differs"), "{said}");
     assert!(peak <= (64 << 20) + scene_baseline, "peak {peak}");
     for (what, input, message) in &cases {
@@ -353,7 +358,11 @@ fn each_case_names_the_real_problem_with_one_exit_code_rule() {
     // SAFETY: getuid has no preconditions.
     let root = unsafe { libc::getuid() } == 0;
     let args = ["bake", &env, "--backend", "cpu", "--size", "16", "--out", locked.to_str().unwrap()];
-    let as_user = if root { Command::new("setpriv").args(["--reuid=65534", "--regid=65534", "--clear-groups", env!("CARGO_BIN_EXE_runner")]).args(args).output().ok() } else { runner().args(args).output().ok() };
+    let as_user = if root {
+        Command::new("setpriv").args(["--reuid=65534", "--regid=65534", "--clear-groups", env!("CARGO_BIN_EXE_runner")]).args(args).output().ok()
+    } else {
+        runner().args(args).output().ok()
+    };
     // Skipped where nobody may run the binary (a checkout under a private home folder).
     if let Some(o) = as_user.filter(|o| !matches!(o.status.code(), Some(126 | 127)) && !String::from_utf8_lossy(&o.stderr).contains("failed to execute")) {
         let said = format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
@@ -398,7 +407,22 @@ fn each_case_names_the_real_problem_with_one_exit_code_rule() {
     // 2²⁰ samples at mip 1 of 2² faces, doubling: mip 2 would take 2²¹ (mip 3, r = 1, is summed exactly).
     let capped = dir("capped");
     let (code, said) = run_code(&[
-        "bake", small.to_str().unwrap(), "--backend", "cpu", "--size", "4", "--source-size", "8", "--mips", "3", "--sampled-only", "--samples", "1048576", "--force", "--out", &capped,
+        "bake",
+        small.to_str().unwrap(),
+        "--backend",
+        "cpu",
+        "--size",
+        "4",
+        "--source-size",
+        "8",
+        "--mips",
+        "3",
+        "--sampled-only",
+        "--samples",
+        "1048576",
+        "--force",
+        "--out",
+        &capped,
     ]);
     assert_eq!(code, 0, "{said}");
     assert!(said.contains("mip 2 takes 1048576 GGX samples per texel, not the 2097152 that --samples × --sample-growth^1 asks for"), "{said}");

@@ -320,7 +320,10 @@ fn a_16k_hdr_bakes_within_2_gib() {
 #[test]
 fn each_step_reports_its_start_and_estimate() {
     let d = scratch("steps");
-    let o = runner().args(["bake", &courtyard(), "--backend", "cpu", "--size", "128", "--samples", "1024", "--out", d.join("out").to_str().unwrap()]).output().unwrap();
+    let o = runner()
+        .args(["bake", &courtyard(), "--backend", "cpu", "--size", "128", "--samples", "1024", "--out", d.join("out").to_str().unwrap()])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", text(&o));
     let err = String::from_utf8_lossy(&o.stderr);
     for step in ["reading ", "calibrating ", "source cube…", "specular… (estimate ", "irradiance…", "brdf lut…", "writing the files…"] {

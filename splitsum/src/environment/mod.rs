@@ -122,7 +122,9 @@ impl InputReport {
         let mut out = Vec::new();
         let (w, h) = self.original;
         match shape {
-            InputShape::Equirect { width, height } if width < w => out.push(Adjustment::Reduced { from: (w, h), to: (width, height), source_size: self.read_for }),
+            InputShape::Equirect { width, height } if width < w => {
+                out.push(Adjustment::Reduced { from: (w, h), to: (width, height), source_size: self.read_for })
+            }
             InputShape::Cube { size } if size < w => out.push(Adjustment::FacesReduced { from: w, to: size }),
             _ => {}
         }

@@ -60,14 +60,19 @@ fn exr_raw_data_window(r: &mut impl std::io::BufRead) -> Option<[i32; 4]> {
 pub(super) fn exr_header<R: std::io::BufRead + std::io::Seek>(path: &Path, reader: &mut R, len: u64) -> Result<ExrHeader> {
     let malformed = |why: String| Error::file(path, format!("malformed OpenEXR: {why}"));
     if let Some([x0, y0, x1, y1]) = exr_raw_data_window(reader)
-        && (x1 < x0 || y1 < y0) {
-            return Err(malformed(format!("its data window is inverted (from ({x0}, {y0}) to ({x1}, {y1}))")));
-        }
+        && (x1 < x0 || y1 < y0)
+    {
+        return Err(malformed(format!("its data window is inverted (from ({x0}, {y0}) to ({x1}, {y1}))")));
+    }
     reader.seek(std::io::SeekFrom::Start(0)).map_err(|e| Error::file_caused(path, "cannot read", e))?;
     let meta = exr::meta::MetaData::read_from_buffered(reader, false).map_err(|e| exr_error(path, e))?;
     let header = meta.headers.iter().find(|h| !h.deep && exr_channels(h).is_some()).ok_or_else(|| {
         let names: Vec<String> = meta.headers.iter().flat_map(|h| h.channels.list.iter().map(|c| c.name.to_string())).collect();
-        if meta.headers.iter().all(|h| h.deep) { malformed("only deep data, which is not an image".into()) } else { Error::file(path, format!("has no R, G, B (or Y) channels, only {names:?}")) }
+        if meta.headers.iter().all(|h| h.deep) {
+            malformed("only deep data, which is not an image".into())
+        } else {
+            Error::file(path, format!("has no R, G, B (or Y) channels, only {names:?}"))
+        }
     })?;
     let size = header.layer_size;
     let (w, h) = (size.width().min(u32::MAX as usize) as u32, size.height().min(u32::MAX as usize) as u32);
@@ -79,7 +84,10 @@ pub(super) fn exr_header<R: std::io::BufRead + std::io::Seek>(path: &Path, reade
     if chunks.saturating_mul(16) > len {
         return Err(Error::file(
             path,
-            format!("truncated OpenEXR: its header promises {w}×{h} pixels in {chunks} blocks, which take at least {} bytes, but the file has {len}", chunks * 16),
+            format!(
+                "truncated OpenEXR: its header promises {w}×{h} pixels in {chunks} blocks, which take at least {} bytes, but the file has {len}",
+                chunks * 16
+            ),
         ));
     }
     Ok(ExrHeader { size: (w, h), channels: exr_channels(header).expect("found above") })
@@ -103,7 +111,9 @@ fn exr_channels(header: &exr::meta::header::Header) -> Option<ExrChannels> {
 /// An `exr` crate error in the user's terms.
 fn exr_error(path: &Path, e: exr::error::Error) -> Error {
     match e {
-        exr::error::Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => Error::file(path, "truncated OpenEXR: the file ends before its last block"),
+        exr::error::Error::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            Error::file(path, "truncated OpenEXR: the file ends before its last block")
+        }
         exr::error::Error::Io(io) => Error::file(path, format!("cannot read: {io}")),
         exr::error::Error::NotSupported(what) => Error::file(path, format!("an OpenEXR feature the exr crate does not read: {what}")),
         // The offset table points past the end: the file was cut short.

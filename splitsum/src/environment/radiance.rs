@@ -9,7 +9,10 @@ use std::path::Path;
 /// rows than the file can hold is refused.
 pub(super) fn check_hdr_length(path: &Path, h: u32, len: u64) -> Result<()> {
     if len < 4 * h as u64 {
-        return Err(Error::file(path, format!("truncated Radiance HDR: its header promises {h} scanlines, which take at least {} bytes, but the file has {len}", 4 * h as u64)));
+        return Err(Error::file(
+            path,
+            format!("truncated Radiance HDR: its header promises {h} scanlines, which take at least {} bytes, but the file has {len}", 4 * h as u64),
+        ));
     }
     Ok(())
 }
@@ -20,7 +23,14 @@ pub(super) fn read_hdr(path: &Path, weights: Weights, sanitize: bool, factor: u3
 }
 
 /// [`read_hdr`] from `r`, which holds `len` bytes; `path` names it in errors.
-pub(super) fn read_hdr_from(path: &Path, mut r: impl std::io::BufRead, len: u64, weights: Weights, sanitize: bool, factor: u32) -> Result<(Equirect, InputReport)> {
+pub(super) fn read_hdr_from(
+    path: &Path,
+    mut r: impl std::io::BufRead,
+    len: u64,
+    weights: Weights,
+    sanitize: bool,
+    factor: u32,
+) -> Result<(Equirect, InputReport)> {
     let (w, h) = rgbe::header(path, &mut r)?;
     check_side(path, w, h)?;
     check_hdr_length(path, h, len)?;

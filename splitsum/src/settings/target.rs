@@ -68,16 +68,16 @@ impl Target {
         }
     }
 
-    /// What the target's engine reads: Khronos a specular, an irradiance and a sheen cube
-    /// and the tables (every folder of glTF-Sample-Environments has `charlie/sheen.ktx2`);
-    /// Bevy the same without sheen (Bevy shades no sheen); Filament the specular cube and
-    /// SH9 (its table, cloth's term included, is built in); splitsum everything but sheen,
-    /// which a bake adds when asked ([`Products::with_sheen`]).
+    /// What every material of the target's engine reads: Khronos and Bevy a specular and an
+    /// irradiance cube and the table; Filament the specular cube and SH9 (its table, cloth's
+    /// term included, is built in); splitsum everything but sheen. Sheen is read only by
+    /// materials with `KHR_materials_sheen`: a bake adds it when asked
+    /// ([`Products::with_sheen`]; khronos then writes the `charlie/` folder and tables of
+    /// glTF-Sample-Environments' layout), as a scene's plan does for a sheen material.
     pub fn products(self) -> Products {
         match self {
             Target::Splitsum => Products::STANDARD,
-            Target::Khronos => Products::DISPLAY.with(Product::Sheen, true),
-            Target::Bevy => Products::DISPLAY,
+            Target::Khronos | Target::Bevy => Products::DISPLAY,
             Target::Filament => Products::of(&[Product::Specular, Product::Sh9]),
         }
     }
