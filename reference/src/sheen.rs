@@ -111,3 +111,51 @@ pub fn prefilter(env: &crate::Environment, n: [f64; 3], roughness: f64) -> [f64;
     let (acc, wsum) = env.integrate(w, |_| width);
     if wsum[0] > 0.0 { acc.map(|v| v / wsum[0]) } else { [0.0; 3] }
 }
+
+/// The same sheen-prefiltered radiance as [`prefilter`], of a sky given as a function of
+/// direction, by a product quadrature written in the lobe's own coordinates instead of over
+/// texels: with `u = n·l` and `φ` the azimuth about `n`, the weight `D(h)(n·l)dω` is
+/// `∝ u(1 − u)^k du dφ`, `k = 1/(2α)` (`n·h = √((1 + u)/2)`, `sin²θ = (1 − u)/2`). `u` by
+/// Gauss–Legendre, 8 points on each of `panels` equal pieces of `[0, min(1, 60/k)]` (the
+/// weight beyond is below `e⁻⁶⁰`), `φ` by the midpoint rule at `azimuths` points; where
+/// `α < 10⁻⁵` (the lobe within `10⁻⁴` of the horizon) the mean over the horizon circle.
+pub fn prefilter_of(sky: &dyn Fn([f64; 3]) -> [f64; 3], n: [f64; 3], roughness: f64, panels: usize, azimuths: usize) -> [f64; 3] {
+    let n = crate::normalize(n);
+    // A tangent frame: any unit vector off n, made orthogonal.
+    let a = if n[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+    let d = crate::dot(a, n);
+    let t = crate::normalize([a[0] - d * n[0], a[1] - d * n[1], a[2] - d * n[2]]);
+    let b = [n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2], n[0] * t[1] - n[1] * t[0]];
+    let ring = |u: f64| {
+        let s = (1.0 - u * u).max(0.0).sqrt();
+        let mut acc = [0.0; 3];
+        for j in 0..azimuths {
+            let phi = std::f64::consts::TAU * (j as f64 + 0.5) / azimuths as f64;
+            let (sp, cp) = phi.sin_cos();
+            let l = [0, 1, 2].map(|c| s * (cp * t[c] + sp * b[c]) + u * n[c]);
+            let v = sky(l);
+            (0..3).for_each(|c| acc[c] += v[c]);
+        }
+        acc.map(|v| v / azimuths as f64)
+    };
+    let al = alpha(roughness);
+    if al < 1e-5 {
+        return ring(0.0);
+    }
+    let k = 0.5 / al;
+    let top = (60.0 / k).min(1.0);
+    let h = top / panels as f64;
+    let rule = crate::quadrature::gauss_legendre(8, 0.0, h);
+    let (mut acc, mut wsum) = ([0.0; 3], 0.0);
+    for p in 0..panels {
+        for &(x, w) in &rule {
+            let u = p as f64 * h + x;
+            // u(1 − u)^k in the log domain: no underflow for large k.
+            let wu = w * (u.ln() + k * (-u).ln_1p()).exp();
+            let r = ring(u);
+            (0..3).for_each(|c| acc[c] += wu * r[c]);
+            wsum += wu;
+        }
+    }
+    acc.map(|v| v / wsum)
+}
