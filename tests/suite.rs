@@ -3,6 +3,7 @@
 //! (`cargo test --test suite -- prefilter:: lut:: …`).
 
 mod architecture;
+mod book;
 mod choices;
 mod cli;
 mod commands;

@@ -44,6 +44,8 @@
 //! courtyard HDRI the command line shows when given none.
 
 #![warn(missing_docs)]
+// On docs.rs (nightly rustdoc, `--cfg docsrs`): each item gated by a feature says which.
+#![cfg_attr(docsrs, feature(doc_cfg))]
 
 /// Declares modules public with the `internals` feature and private without it.
 macro_rules! internal_modules {

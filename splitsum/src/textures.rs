@@ -39,6 +39,18 @@ pub enum Compute {
 }
 
 /// What to bake from.
+///
+/// ```no_run
+/// # fn sources(device: &wgpu::Device, queue: &wgpu::Queue, sky_texture: &wgpu::Texture) -> Result<(), splitsum::Error> {
+/// use splitsum::{Baker, Compute, Settings, Source};
+/// let baker = Baker::new(device, queue, Compute::Gpu)?;
+/// // From a file read into host memory (.hdr, .exr, or a folder of six faces)…
+/// let (sky, _report) = splitsum::environment::load(std::path::Path::new("sky.hdr"), false)?;
+/// let from_file = baker.bake(Source::Environment(&sky), &Settings::default())?;
+/// // …or from a texture already on the device (an equirect or a six-layer cube).
+/// let from_texture = baker.bake(Source::Texture(sky_texture), &Settings::default())?;
+/// # Ok(()) }
+/// ```
 #[derive(Copy, Clone)]
 pub enum Source<'a> {
     /// An equirect image or six cube faces in host memory (`crate::environment` reads
@@ -65,6 +77,24 @@ pub struct SheenTextures {
 }
 
 /// The baked products as textures on the caller's device.
+///
+/// ```no_run
+/// # fn bind(device: &wgpu::Device, queue: &wgpu::Queue, ibl: &splitsum::Ibl) -> Result<(), splitsum::Error> {
+/// use splitsum::Ibl;
+/// // Bindings 0, 1, 2: the specular cube, the irradiance cube, the table.
+/// let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+///     label: Some("ibl"),
+///     entries: &Ibl::layout_entries(0, wgpu::ShaderStages::FRAGMENT),
+/// });
+/// let views = ibl.views();
+/// let group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some("ibl"), layout: &layout, entries: &views.entries(0) });
+/// // The shader reads the specular cube at this lod for roughness 0.5.
+/// let lod = ibl.lod(0.5);
+/// // Back to host memory, and as files.
+/// let baked = ibl.read(device, queue)?;
+/// splitsum::output::write(std::path::Path::new("out"), &baked, &ibl.job, Default::default())?;
+/// # Ok(()) }
+/// ```
 pub struct Ibl {
     /// Prefiltered specular radiance: a cube (six layers) of `Rgba16Float`, mip `m` at
     /// roughness `roughness[m]` (GGX, `α = roughness²`).
@@ -109,6 +139,18 @@ impl IblViews {
 }
 
 /// Bakes on the caller's device.
+///
+/// ```no_run
+/// # fn bake(device: &wgpu::Device, queue: &wgpu::Queue) -> Result<(), splitsum::Error> {
+/// use splitsum::{Baker, Compute, Settings, Source};
+/// let (sky, _report) = splitsum::environment::load(std::path::Path::new("sky.exr"), false)?;
+/// // Pipelines are built once: keep the baker to bake again.
+/// let baker = Baker::new(device, queue, Compute::Gpu)?;
+/// let ibl = baker.bake(Source::Environment(&sky), &Settings::default())?;
+/// let with_sheen = baker.bake_with_sheen(Source::Environment(&sky), &Settings::default())?;
+/// assert!(ibl.sheen.is_none() && with_sheen.sheen.is_some());
+/// # Ok(()) }
+/// ```
 pub struct Baker {
     device: wgpu::Device,
     queue: wgpu::Queue,

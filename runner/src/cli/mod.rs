@@ -459,6 +459,30 @@ where
 }
 
 /// Parses `args` (the program name first) and runs the command.
+/// The command-line reference as Markdown: `runner --help` and every subcommand's, as the
+/// binary prints them. The guide's `book/src/cli.md` is this text, and a test
+/// (`tests/book.rs`) fails when the two differ, so the chapter cannot drift from the flags.
+pub fn reference_markdown() -> String {
+    use clap::CommandFactory;
+    let mut command = Cli::command();
+    command.build();
+    let mut out = String::from(
+        "# The command line\n\n<!-- Generated from the clap definitions (runner::cli::reference_markdown); \
+         regenerate with SPLITSUM_BLESS=1 cargo test --release -p splitsum-tests --test suite book -->\n\n\
+         Every subcommand's `--help`, as `runner` prints it. [Commands, baking and the defaults](commands.md) \
+         says what the defaults are and why.\n",
+    );
+    let mut section = |name: &str, help: String| {
+        out.push_str(&format!("\n## `{name}`\n\n```text\n{}\n```\n", help.trim_end()));
+    };
+    section("runner", command.render_long_help().to_string());
+    for sub in command.get_subcommands_mut().filter(|s| s.get_name() != "help") {
+        let name = format!("runner {}", sub.get_name());
+        section(&name, sub.render_long_help().to_string());
+    }
+    out
+}
+
 pub fn run<I, T>(args: I) -> anyhow::Result<()>
 where
     I: IntoIterator<Item = T>,

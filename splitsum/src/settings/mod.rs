@@ -94,6 +94,20 @@ pub mod named {
 /// from `size` and the target, the roughness mapping and the table's masking from the
 /// target and the table method, the irradiance and SH9 source levels from the source size.
 /// So `Settings { size: 512, ..Default::default() }` bakes 512² faces with 7 mips.
+///
+/// ```
+/// use splitsum::environment::InputShape;
+/// use splitsum::{Field, Products, Settings, Target};
+/// let job = Settings { size: 512, ..Settings::default() }.resolve(InputShape::Unknown, Products::STANDARD)?;
+/// assert_eq!((job.size, job.mips), (512, 7));
+/// // An engine target fills in what its engine assumes: glTF-IBL-Sampler's floor(log2 size) mips.
+/// let khronos = Settings::default().with_target(Target::Khronos).resolve(InputShape::Unknown, Target::Khronos.products())?;
+/// assert_eq!(khronos.mips, 8);
+/// // Errors name the field.
+/// let e = Settings { size: 48, ..Settings::default() }.resolve(InputShape::Unknown, Products::STANDARD).unwrap_err();
+/// assert!(matches!(e, splitsum::Error::Setting { field: Field::Size, .. }), "{e}");
+/// # Ok::<(), splitsum::Error>(())
+/// ```
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Settings {
     /// Whose conventions the files follow (an engine target fixes the facing, the
