@@ -167,3 +167,30 @@ fn the_readme_is_short() {
     let n = std::fs::read_to_string(root().join("README.md")).unwrap().lines().count();
     assert!(n <= 200, "README.md has {n} lines");
 }
+
+/// The README's accuracy figures are those of `book/src/figures/sets.md`, which
+/// `runner report ENV --sets` writes (`figures.md`, with its date, machine and commit) and
+/// the accuracy chapter includes: held out, the defaults over every point, at `n·v ≥ 0.6`
+/// and at `n·v ≤ 0.1`, 16 fetches, and the seed's settings.
+#[test]
+fn the_readmes_accuracy_figures_are_the_generated_ones() {
+    let figures = std::fs::read_to_string(root().join("book/src/figures/sets.md")).unwrap();
+    let header: Vec<&str> = figures.lines().find(|l| l.starts_with("| method |")).expect("the table's header").split('|').map(str::trim).collect();
+    let cell = |method: &str, column: &str| -> String {
+        let row: Vec<&str> =
+            figures.lines().find(|l| l.starts_with(&format!("| {method}"))).unwrap_or_else(|| panic!("no row {method}")).split('|').map(str::trim).collect();
+        let k = header.iter().position(|h| *h == column).unwrap_or_else(|| panic!("no column {column}"));
+        row[k].to_string()
+    };
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap().replace('\n', " ");
+    for (method, column) in [
+        ("defaults (one fetch)", "held-out set: all"),
+        ("defaults (one fetch)", "held-out set: n·v 0.6–1"),
+        ("defaults (one fetch)", "held-out set: ≤ 0.1"),
+        ("defaults, 16 fetches", "held-out set: all"),
+        ("seed", "held-out set: all"),
+    ] {
+        let figure = cell(method, column);
+        assert!(readme.contains(&figure), "README.md does not quote {method}, {column}: {figure}");
+    }
+}

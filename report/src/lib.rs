@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod accuracy;
+pub mod figures;
 pub mod horizon;
 pub mod measurement;
 pub mod pages;

@@ -433,6 +433,9 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
     })?;
 
     let devices = backends.iter().map(|b| b.describe()).collect::<Vec<_>>().join("; ");
+    if let Some(headline) = crate::figures::headline(rows, &format!("runner report {name} --sets"), &backends[0].describe()) {
+        files::write_atomic(&dir.join("figures.md"), |w| std::io::Write::write_all(w, headline.as_bytes()))?;
+    }
     let setup = format!(
         "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)). Backends: {devices}.",
         sweep.source_size, sweep.specular_size, sweep.mips
@@ -493,10 +496,29 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
         "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>splitsum: error against run time, {}</title>\n<style>body{{font-family:sans-serif;max-width:1120px;margin:2em auto;color:#222}} table{{border-collapse:collapse;font-size:13px;margin:0.5em 0 1.5em}} td,th{{border:1px solid #ccc;padding:2px 6px;text-align:right}} td:nth-child(-n+5),th:nth-child(-n+5){{text-align:left}} figure{{margin:1em 0}} .maps img{{image-rendering:pixelated;border:1px solid #ddd;margin-right:8px}}</style></head><body>",
         html_escape(name)
     );
-    let _ = writeln!(html, "<h1>splitsum: error against run time</h1>\n<p>{}</p>\n<p>{}</p>", html_escape(&setup), html_escape(references));
+    let _ = writeln!(html, "<h1>splitsum: error against run time</h1>\n<p>{}</p>", html_escape(&setup));
+    // The headline first: the sets' figures (where measured) and the error against time;
+    // the details below it, collapsed.
+    if let Some((header, cells)) = crate::figures::headline_table(rows) {
+        let _ = writeln!(
+            html,
+            "<h2 id=\"headline\">Accuracy on the tuning and held-out sets</h2>\n<p>{}</p>\n<table><tr>{}</tr>",
+            html_escape(&crate::figures::provenance(&backends[0].describe())),
+            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
+        );
+        for c in cells {
+            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
+        }
+        let _ = writeln!(html, "</table>");
+    }
     let _ = writeln!(
         html,
         "<figure id=\"error-vs-time\"><img src=\"error_vs_time.svg\" alt=\"error against run time, one panel per product\"><figcaption>Mean relative error against bake time, one panel per product: one colour per method, the GPU solid and the CPU dashed; ringed points are each panel's Pareto front.</figcaption></figure>"
+    );
+    let _ = writeln!(
+        html,
+        "<details><summary>Details: the references, the error on surfaces, the shading ladder, the budgets, the sets per environment and every product's table</summary>\n<p>{}</p>",
+        html_escape(references)
     );
     let _ = writeln!(html, "<h2>The error on surfaces</h2>\n<p>{}</p>", html_escape(&grid));
     for (k, (what, map)) in maps.iter().enumerate() {
@@ -555,7 +577,7 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
             r.mean_error
         );
     }
-    let _ = writeln!(html, "</table></body></html>");
+    let _ = writeln!(html, "</table></details></body></html>");
     files::write_atomic(&dir.join("report.html"), |w| std::io::Write::write_all(w, html.as_bytes()))?;
     Ok(())
 }

@@ -83,20 +83,33 @@ fn sci(v: f64) -> String {
     if (-2..=3).contains(&e) { format!("{}", k * 10f64.powi(e)).trim_end_matches(".0").to_string() } else { format!("{k}e{e}") }
 }
 
+/// 1, 2 and 5 of every decade in `range` (the powers of ten alone past three decades): the
+/// error axis's ticks, so that a panel spanning one decade still has values to read
+/// (plotters' own log ticks give only the decade's ends below 1).
+fn one_two_five(range: std::ops::Range<f64>) -> Vec<f64> {
+    let (lo, hi) = (range.start.log10().floor() as i32, range.end.log10().ceil() as i32);
+    let steps: &[f64] = if hi - lo > 3 { &[1.0] } else { &[1.0, 2.0, 5.0] };
+    (lo..=hi)
+        .flat_map(|e| steps.iter().map(move |k| k * 10f64.powi(e)))
+        .filter(|v| *v >= range.start * (1.0 - 1e-9) && *v <= range.end * (1.0 + 1e-9))
+        .collect()
+}
+
 type Error = Box<dyn std::error::Error>;
 
 /// The small multiples as an SVG document: `columns` panels a row, a legend on top.
 pub fn small_multiples(panels: &[Panel], columns: usize) -> Result<String, Error> {
     let columns = columns.max(1);
     let rows = panels.len().div_ceil(columns).max(1);
-    let (panel_w, panel_h, legend_h) = (360u32, 280u32, 70u32);
+    let (panel_w, panel_h) = (360u32, 280u32);
+    let (entries, legend_h) = legend_layout(panels, panel_w * columns as u32);
     let size = (panel_w * columns as u32, legend_h + panel_h * rows as u32);
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         root.fill(&WHITE)?;
         let (legend, grid) = root.split_vertically(legend_h);
-        draw_legend(&legend, panels)?;
+        draw_legend(&legend, &entries, legend_h)?;
         let areas = grid.split_evenly((rows, columns));
         for (panel, area) in panels.iter().zip(areas) {
             draw_panel(&area, panel)?;
@@ -106,23 +119,36 @@ pub fn small_multiples(panels: &[Panel], columns: usize) -> Result<String, Error
     Ok(svg)
 }
 
-fn draw_legend(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panels: &[Panel]) -> Result<(), Error> {
+/// Where each method's legend entry goes: entries left to right, wrapped before they would
+/// pass the width (a 14 px sans-serif character taken as 8.5 px wide, wider than most), and
+/// the legend's height: a 20 px line per row of methods and one for the line styles.
+fn legend_layout(panels: &[Panel], width: u32) -> (Vec<(Method, i32, i32)>, u32) {
     let mut methods: Vec<Method> = panels.iter().flat_map(|p| p.series.iter().map(|s| s.method)).collect();
     methods.sort();
     methods.dedup();
-    let font = ("sans-serif", 14).into_font();
     let (mut x, mut y) = (10i32, 8i32);
+    let mut out = Vec::new();
     for m in methods {
-        let c = method_colour(m);
-        area.draw(&Rectangle::new([(x, y + 3), (x + 22, y + 13)], c.filled()))?;
-        area.draw(&Text::new(m.title(), (x + 28, y), font.clone()))?;
-        x += 40 + 8 * m.title().len() as i32;
-        if x > area.dim_in_pixel().0 as i32 - 200 {
+        let w = 40 + (8.5 * m.title().chars().count() as f64) as i32;
+        if x > 10 && x + w > width as i32 - 10 {
             x = 10;
             y += 20;
         }
+        out.push((m, x, y));
+        x += w;
     }
-    y += 22;
+    let styles = if out.is_empty() { 8 } else { y + 24 };
+    (out, (styles + 28) as u32)
+}
+
+fn draw_legend(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, entries: &[(Method, i32, i32)], height: u32) -> Result<(), Error> {
+    let font = ("sans-serif", 14).into_font();
+    for &(m, x, y) in entries {
+        let c = method_colour(m);
+        area.draw(&Rectangle::new([(x, y + 3), (x + 22, y + 13)], c.filled()))?;
+        area.draw(&Text::new(m.title(), (x + 28, y), font.clone()))?;
+    }
+    let y = height as i32 - 26;
     let black = RGBColor(40, 40, 40);
     area.draw(&PathElement::new(vec![(10, y + 8), (40, y + 8)], black.stroke_width(2)))?;
     area.draw(&Text::new("GPU backend", (46, y), font.clone()))?;
@@ -144,7 +170,7 @@ fn draw_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel:
         .margin(8)
         .x_label_area_size(34)
         .y_label_area_size(52)
-        .build_cartesian_2d(xr.log_scale(), yr.log_scale())?;
+        .build_cartesian_2d(xr.log_scale(), yr.clone().log_scale().with_key_points(one_two_five(yr)))?;
     chart
         .configure_mesh()
         .x_desc(panel.x_label.as_str())
