@@ -86,6 +86,18 @@ pub fn headline(rows: &[Measurement], command: &str, device: &str) -> Option<Str
     Some(md)
 }
 
+/// How this report was run: the process's own arguments where it is the `runner` binary,
+/// else (a test calling the library) `runner report ENV --sets`.
+pub fn command_line(environment: &str) -> String {
+    let args: Vec<String> = std::env::args().collect();
+    let binary = args.first().and_then(|a| std::path::Path::new(a).file_stem().map(|s| s.to_string_lossy().to_string()));
+    if binary.as_deref() == Some("runner") {
+        std::iter::once("runner".to_string()).chain(args.into_iter().skip(1)).collect::<Vec<_>>().join(" ")
+    } else {
+        format!("runner report {environment} --sets")
+    }
+}
+
 /// Today's date in UTC, `YYYY-MM-DD` (days since 1970 to the civil date: Hinnant's
 /// `civil_from_days`).
 fn today() -> String {

@@ -433,7 +433,7 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
     })?;
 
     let devices = backends.iter().map(|b| b.describe()).collect::<Vec<_>>().join("; ");
-    if let Some(headline) = crate::figures::headline(rows, &format!("runner report {name} --sets"), &backends[0].describe()) {
+    if let Some(headline) = crate::figures::headline(rows, &crate::figures::command_line(name), &backends[0].describe()) {
         files::write_atomic(&dir.join("figures.md"), |w| std::io::Write::write_all(w, headline.as_bytes()))?;
     }
     let setup = format!(
