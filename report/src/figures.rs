@@ -41,7 +41,8 @@ pub fn set_mean(rows: &[Measurement], set: Set, method: Method, fetches: u32, sa
     (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64)
 }
 
-/// The headline table: a row per method of [`LINES`], a column per set and `n·v` band;
+/// The headline table: a row per method (the defaults, 16 fetches, the seed's settings), a
+/// column per set and `n·v` band;
 /// `None` where the report measured no set.
 pub fn headline_table(rows: &[Measurement]) -> Option<(Vec<String>, Vec<Vec<String>>)> {
     if !rows.iter().any(|r| r.set.is_some()) {
