@@ -214,15 +214,7 @@ fn tap_index(layout: CubeLayout, level: u32, face: u32, x: i32, y: i32, s: u32) 
         return layout.index(level, face, x as u32, y as u32);
     }
     // Off the face in one axis: the edge crossed and the coordinate along it.
-    let edge = if x < 0 {
-        0
-    } else if x >= si {
-        1
-    } else if y < 0 {
-        2
-    } else {
-        3
-    };
+    let edge = if x < 0 { 0 } else if x >= si { 1 } else if y < 0 { 2 } else { 3 };
     let t = (if edge < 2 { y } else { x }) as u32;
     let (f, ex, ey) = edge_texel(face, edge, t, s);
     if inside { layout.index(level, face, x as u32, y as u32) } else { layout.index(level, f, ex, ey) }
@@ -250,17 +242,7 @@ pub fn edge_texel(face: u32, edge: u32, t: u32, s: u32) -> (u32, u32, u32) {
     };
     let entry = (word >> (7 * edge)) & 127;
     let last = s.wrapping_sub(1);
-    let pick = |code: u32| {
-        if code == 0 {
-            0
-        } else if code == 1 {
-            last
-        } else if code == 2 {
-            t
-        } else {
-            last.wrapping_sub(t)
-        }
-    };
+    let pick = |code: u32| if code == 0 { 0 } else if code == 1 { last } else if code == 2 { t } else { last.wrapping_sub(t) };
     (entry & 7, pick((entry >> 3) & 3), pick((entry >> 5) & 3))
 }
 

@@ -223,18 +223,7 @@ pub fn lobe_samples(lobe: Lobe, samples: u32, roughness: f32, src_size: u32, lod
 /// `1/N` (Charlie's follow the whole weight), read trilinearly at the sample's source level.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn add_sample(
-    src: &[Vec4],
-    layout: CubeLayout,
-    n: Vec3,
-    t: Vec3,
-    b: Vec3,
-    g: Vec4,
-    cosine: bool,
-    inv_count: f32,
-    acc: &mut math::CompensatedSum4,
-    wsum: &mut math::CompensatedSum,
-) {
+fn add_sample(src: &[Vec4], layout: CubeLayout, n: Vec3, t: Vec3, b: Vec3, g: Vec4, cosine: bool, inv_count: f32, acc: &mut math::CompensatedSum4, wsum: &mut math::CompensatedSum) {
     let l = t * g.x + b * g.y + n * g.z;
     let n_dot_l = g.z;
     if n_dot_l > 0.0 {
@@ -249,17 +238,7 @@ fn add_sample(
 /// [`accumulate_samples`] run.
 #[inline]
 #[allow(clippy::too_many_arguments)]
-fn accumulate_with(
-    src: &[Vec4],
-    layout: CubeLayout,
-    n: Vec3,
-    cosine: bool,
-    total: u32,
-    start: u32,
-    count: u32,
-    p: MeanPartial,
-    sample: impl Fn(u32) -> Vec4,
-) -> MeanPartial {
+fn accumulate_with(src: &[Vec4], layout: CubeLayout, n: Vec3, cosine: bool, total: u32, start: u32, count: u32, p: MeanPartial, sample: impl Fn(u32) -> Vec4) -> MeanPartial {
     // A zero or non-finite direction is read as +z rather than turned into NaN.
     let n = sampling::normalize_or(n, Vec3::Z);
     // Weights n·l/N sum to at most 1: no overflow, whatever the radiance.
@@ -415,17 +394,7 @@ pub fn exact_level(lobe: Lobe, roughness: f32, samples: u32, layout: CubeLayout)
 /// Adds texels `start .. start + count` of source level `level` to the exact mean weighted
 /// by `lobe` for direction `n` and `roughness` (see the module header).
 #[allow(clippy::too_many_arguments)]
-pub fn exact_accumulate(
-    lobe: Lobe,
-    src: &[Vec4],
-    layout: CubeLayout,
-    level: u32,
-    n: Vec3,
-    roughness: f32,
-    start: u32,
-    count: u32,
-    p: MeanPartial,
-) -> MeanPartial {
+pub fn exact_accumulate(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
     let n = sampling::normalize_or(n, Vec3::Z);
     let alpha = lobe.alpha(roughness);
     // GGX: D ≤ 1/(πα²) and Ω ≤ 4π/6: scaled by α² so no weight exceeds about 1. Charlie:

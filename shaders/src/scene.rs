@@ -235,16 +235,7 @@ pub fn shade_point(
 /// Linear radiance seen through pixel position `px` (a sphere of the grid, or the sky) and
 /// its depth in [0, 1] (1 for the sky).
 #[allow(clippy::too_many_arguments)]
-pub fn radiance_depth(
-    frame: &Frame,
-    source: &[Vec4],
-    specular: &[Vec4],
-    irradiance: &[Vec4],
-    table: &[Vec2],
-    sheen: &[Vec4],
-    sheen_tables: &[Vec2],
-    px: Vec2,
-) -> (Vec3, f32) {
+pub fn radiance_depth(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], sheen: &[Vec4], sheen_tables: &[Vec2], px: Vec2) -> (Vec3, f32) {
     let origin = frame.eye.truncate();
     let dir = camera_ray(frame, px);
     if frame.flags & Frame::SPHERES != 0 {
@@ -263,16 +254,7 @@ pub fn radiance_depth(
 
 /// Linear radiance seen through pixel position `px`.
 #[allow(clippy::too_many_arguments)]
-pub fn radiance(
-    frame: &Frame,
-    source: &[Vec4],
-    specular: &[Vec4],
-    irradiance: &[Vec4],
-    table: &[Vec2],
-    sheen: &[Vec4],
-    sheen_tables: &[Vec2],
-    px: Vec2,
-) -> Vec3 {
+pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], sheen: &[Vec4], sheen_tables: &[Vec2], px: Vec2) -> Vec3 {
     radiance_depth(frame, source, specular, irradiance, table, sheen, sheen_tables, px).0
 }
 

@@ -23,6 +23,7 @@ pub enum Tonemapper {
     Clamp = 2,
 }
 
+
 /// Rec. 709 relative luminance.
 #[inline]
 pub fn luminance(c: Vec3) -> f32 {

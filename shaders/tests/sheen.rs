@@ -116,10 +116,7 @@ fn sheen_albedo_matches_the_f64_reference() {
     let mut worst = (0.0f64, 0.0f32, 0.0f32, "");
     for &r in &ROUGHNESS {
         for &nv in &[0.002f32, 0.01, 0.05, 0.1, 0.25, 0.5, 0.75, 0.9, 1.0] {
-            for (vis, rvis, name) in [
-                (sheen::SheenVisibility::Charlie, reference::Visibility::Charlie, "charlie"),
-                (sheen::SheenVisibility::Neubelt, reference::Visibility::Neubelt, "neubelt"),
-            ] {
+            for (vis, rvis, name) in [(sheen::SheenVisibility::Charlie, reference::Visibility::Charlie, "charlie"), (sheen::SheenVisibility::Neubelt, reference::Visibility::Neubelt, "neubelt")] {
                 let got = sheen::albedo(nv, r, vis) as f64;
                 let want = reference::albedo(nv as f64, r as f64, rvis, 1e-8);
                 let err = (got - want).abs();

@@ -87,6 +87,7 @@ pub enum Masking {
     SmithCorrelated = 1,
 }
 
+
 /// The height-correlated Smith visibility of GGX, `V = G₂ / (4 (n·l)(n·v))`, with
 /// `G₂ = 1 / (1 + Λ(v) + Λ(l))` and `Λ(x) = (√(1 + α² tan²θₓ) − 1)/2` (Heitz 2014, eq. 99),
 /// rewritten without tangents as

@@ -70,11 +70,7 @@ fn l_fit(x: f32, alpha: f32) -> f32 {
 #[cfg_attr(not(target_arch = "spirv"), inline)]
 pub fn lambda_charlie(cos_theta: f32, alpha: f32) -> f32 {
     let c = math::saturate(math::abs(cos_theta));
-    if c < 0.5 {
-        math::exp2(l_fit(c, alpha) * core::f32::consts::LOG2_E)
-    } else {
-        math::exp2((2.0 * l_fit(0.5, alpha) - l_fit(1.0 - c, alpha)) * core::f32::consts::LOG2_E)
-    }
+    if c < 0.5 { math::exp2(l_fit(c, alpha) * core::f32::consts::LOG2_E) } else { math::exp2((2.0 * l_fit(0.5, alpha) - l_fit(1.0 - c, alpha)) * core::f32::consts::LOG2_E) }
 }
 
 /// The Charlie visibility `V = 1/((1 + Λ(v) + Λ(l))·4(n·l)(n·v))` (Estevez & Kulla 2017,

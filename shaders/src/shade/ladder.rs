@@ -111,3 +111,4 @@ pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOpti
 pub const LADDER_FULL_BELOW: f32 = 0.4;
 /// Width in `n·v` of the ladder's blend into the one fetch.
 pub const LADDER_BLEND: f32 = 0.3;
+

@@ -463,16 +463,7 @@ pub fn above_horizon(n: Vec3, d: Vec3, roughness: f32) -> Vec3 {
 /// Reads the three baked products for material `m` at normal `n` and view `v`, as `opts`
 /// ask (the read direction, the mip blend and the fetches depend on them).
 #[allow(clippy::too_many_arguments)]
-pub fn ibl_sample(
-    shape: EnvironmentShape,
-    specular: &[Vec4],
-    irradiance: &[Vec4],
-    table: &[Vec2],
-    opts: ShadeOptions,
-    m: &Material,
-    n: Vec3,
-    v: Vec3,
-) -> IblSample {
+pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3) -> IblSample {
     let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
     IblSample {
         prefiltered: lobe_radiance(shape, specular, opts, m, n, v),
@@ -500,7 +491,10 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
         let kd = if common { Vec3::ONE - f } else { Vec3::splat(ambient_diffuse_weight(n_dot_v)) };
         kd * no_metal * m.base_color * s.irradiance
     };
-    if cook_torrance && opts.flags & ShadeOptions::MULTISCATTER != 0 && opts.diffuse != DiffuseModel::FresnelWeighted as u32 {
+    if cook_torrance
+        && opts.flags & ShadeOptions::MULTISCATTER != 0
+        && opts.diffuse != DiffuseModel::FresnelWeighted as u32
+    {
         let (single, multiple) = multiple_scattering(f, f0, s.brdf);
         let kd = (Vec3::ONE - single - multiple) * no_metal;
         return (kd * m.base_color * s.irradiance + single * s.prefiltered + multiple * s.irradiance) * m.occlusion;
