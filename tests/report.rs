@@ -85,23 +85,45 @@ fn quick_report_writes_tables_csv_and_plot() {
     assert!(md.contains("Best error per millisecond"));
 }
 
-/// `report.html` in a real browser (Debian's chromium, headless): the page loads with its
+/// `report.html` in a real browser (Debian's chromium, headless), with the measure over
+/// sets, quickly: the generated skies and the environments present (city and studio
+/// here), each row in its set; both sets' tables in the report. The page loads with its
 /// figures (an image that fails to load is drawn as a small broken-image icon, so the
-/// page's laid-out height tells), and the screenshot is kept beside the report.
+/// page's laid-out height tells), and its headline (the sets' table and the end-to-end
+/// figure, ended by a rule of a colour nothing else on the page has) fits one 1200×1600
+/// screen. Without --quick, a folder that lacks the studio lights is refused before
+/// anything runs.
 #[test]
-fn the_report_page_renders_in_a_browser() {
+fn the_report_page_renders_in_a_browser_with_its_headline_on_one_screen() {
+    use splitsum::measured::{Part, Quantity, Set, read_csv};
     let Some(chromium) =
         ["chromium", "chromium-browser"].into_iter().find(|c| std::process::Command::new(c).arg("--version").output().is_ok_and(|o| o.status.success()))
     else {
         panic!("chromium is needed (dev.sh test installs it)");
     };
     let dir = std::env::temp_dir().join(format!("splitsum-report-page-{}", std::process::id()));
+    let assets = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments");
     let env = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/studio.exr");
-    runner::cli::run(["runner", "report", env, "--quick", "--backends", "cpu", "--out", dir.to_str().unwrap()]).expect("report");
+    let args = ["runner", "report", env, "--quick", "--backends", "cpu", "--sets", "--environments", assets, "--out", dir.to_str().unwrap()];
+    runner::cli::run(args).expect("report");
+    let rows = read_csv(&std::fs::read_to_string(dir.join("report.csv")).unwrap()).unwrap();
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for (set, env) in [(Set::Tuning, "city"), (Set::Tuning, "overcast sky"), (Set::HeldOut, "studio"), (Set::HeldOut, "sky, sun 10^6 at 65°")] {
+        assert!(
+            rows.iter().any(|r| r.set == Some(set) && r.environment == env && r.product == Quantity::ShadedColour && r.part == Part::SplitSum),
+            "{env} in the {set:?} set"
+        );
+    }
+    assert!(!rows.iter().any(|r| r.environment == "forest"), "absent files are skipped with --quick");
+    assert!(md.contains("## tuning set: city") && md.contains("## held-out set: studio") && md.contains("## each environment"));
+    // The headline figure: the two end-to-end panels, the defaults and the seed only.
+    let headline = std::fs::read_to_string(dir.join("headline.svg")).unwrap();
+    assert!(headline.contains("shaded colour, end to end") && headline.contains("prefiltered lookup, any roughness, end to end"), "headline panels");
     let shot = std::env::temp_dir().join(format!("splitsum-report-page-{}.png", std::process::id()));
     let profile = std::env::temp_dir().join(format!("splitsum-chromium-{}", std::process::id()));
     let out = std::process::Command::new(chromium)
         .args(["--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--window-size=1200,1600"])
+        .args(["--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run"])
         .arg(format!("--user-data-dir={}", profile.display()))
         .arg(format!("--screenshot={}", shot.display()))
         .arg(format!("file://{}", dir.join("report.html").display()))
@@ -110,10 +132,14 @@ fn the_report_page_renders_in_a_browser() {
     assert!(shot.exists(), "no screenshot: {}", String::from_utf8_lossy(&out.stderr));
     let img = image::open(&shot).unwrap().to_rgb8();
     assert_eq!((img.width(), img.height()), (1200, 1600));
-    // The figure: the methods' colours (the seed's orange, the defaults' blue; `plot.rs`)
-    // drawn in the top of the page, where the small multiples sit.
     let has = |c: [u8; 3]| img.pixels().any(|p| p.0.iter().zip(c).all(|(a, b)| a.abs_diff(b) < 12));
+    // The figure: the methods' colours (the seed's orange, the defaults' blue; `plot.rs`).
     assert!(has([213, 94, 0]) && has([0, 114, 178]), "the figure's series are not on the page");
+    // The rule that ends the headline (`pages.rs`): the whole headline is on the first screen.
+    assert!(has([120, 30, 160]), "the headline does not fit a 1200×1600 screen");
+    let _ = std::fs::remove_file(&shot);
+    let e = runner::cli::run(["runner", "report", env, "--sets", "--environments", "/nonexistent", "--out", dir.to_str().unwrap()]).expect_err("refused");
+    assert!(format!("{e:#}").contains("dev.sh environments"), "{e:#}");
     let _ = std::fs::remove_dir_all(&profile);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -149,32 +175,6 @@ fn end_to_end_measure_of_a_constant_sky() {
     assert!(bake < 5e-3 && lookup < 1e-5, "bake {bake:e}, lookup {lookup:e}");
     assert!(split.is_finite());
     assert!(rows.iter().any(|r| r.product == Quantity::ShadedColour && r.time_ms.is_some_and(f64::is_finite)));
-}
-
-/// The measure over sets, quickly: the generated skies and the environments present
-/// (city and studio here), each row in its set; both sets' tables in the report. Without
-/// --quick, a folder that lacks the studio lights is refused before anything runs.
-#[test]
-fn the_measure_over_tuning_and_held_out_sets() {
-    use splitsum::measured::{Part, Quantity, Set, read_csv};
-    let dir = std::env::temp_dir().join(format!("splitsum-report-sets-{}", std::process::id()));
-    let assets = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments");
-    let env = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/environments/studio.exr");
-    let args = ["runner", "report", env, "--quick", "--backends", "cpu", "--sets", "--environments", assets, "--out", dir.to_str().unwrap()];
-    runner::cli::run(args).expect("report");
-    let rows = read_csv(&std::fs::read_to_string(dir.join("report.csv")).unwrap()).unwrap();
-    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    for (set, env) in [(Set::Tuning, "city"), (Set::Tuning, "overcast sky"), (Set::HeldOut, "studio"), (Set::HeldOut, "sky, sun 10^6 at 65°")] {
-        assert!(
-            rows.iter().any(|r| r.set == Some(set) && r.environment == env && r.product == Quantity::ShadedColour && r.part == Part::SplitSum),
-            "{env} in the {set:?} set"
-        );
-    }
-    assert!(!rows.iter().any(|r| r.environment == "forest"), "absent files are skipped with --quick");
-    assert!(md.contains("## tuning set: city") && md.contains("## held-out set: studio") && md.contains("## each environment"));
-    let e = runner::cli::run(["runner", "report", env, "--sets", "--environments", "/nonexistent", "--out", dir.to_str().unwrap()]).expect_err("refused");
-    assert!(format!("{e:#}").contains("dev.sh environments"), "{e:#}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The generated skies against closed forms: the sun's disc holds its radiance times its

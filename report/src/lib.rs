@@ -22,3 +22,4 @@ pub mod sets;
 pub mod skies;
 pub mod surface;
 pub mod sweep;
+mod write;

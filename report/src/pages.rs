@@ -1,18 +1,10 @@
 //! What a report shows, from its typed rows: the panels of the error-against-time figure
-//! (and the best result per millisecond the command line prints), the tables (sweeps, the
-//! tuning and held-out sets, the shading ladder, the time budgets) and the files
-//! `report.html`, `report.md`, `report.csv` and the figures ([`crate::plot`],
-//! [`crate::surface`]). Measuring is [`crate::report`]'s.
+//! (and the best result per millisecond the command line prints) and the tables (sweeps,
+//! the tuning and held-out sets, the shading ladder, the time budgets). Measuring is
+//! [`crate::report`]'s; writing the files is `write.rs`'s (`report::run` calls it).
 
 use crate::measurement::{Knob, Measurement, Method, Part, Quantity};
-use crate::surface::ErrorMap;
-use crate::sweep::Sweep;
-use splitsum::backend::Backend;
-use splitsum::error::Result;
-use splitsum::files;
 use splitsum::settings::Settings;
-use std::fmt::Write as _;
-use std::path::Path;
 
 /// The panel of the error-against-time figure a row belongs to, if any: every sample or
 /// size sweep and every end-to-end method (the bias and cube-size sweeps, and the bands,
@@ -67,6 +59,24 @@ pub fn panels(rows: &[Measurement]) -> Vec<crate::plot::Panel> {
     panels
 }
 
+/// The headline figure's panels: the end-to-end measures (the shaded colour and the
+/// prefiltered lookup) of the defaults at their sample counts beside the seed's method at
+/// its (the seed at 1024 samples is the Khronos glTF-IBL-Sampler's setting), over all
+/// points. The other methods are in [`panels`]' figure, below the headline.
+pub fn headline_panels(rows: &[Measurement]) -> Vec<crate::plot::Panel> {
+    let headline = |r: &&Measurement| {
+        matches!(r.product, Quantity::ShadedColour | Quantity::PrefilteredLookup)
+            && r.knob != Knob::Quality
+            && matches!(r.method, Method::Seed | Method::Defaults)
+            && r.fetches.is_none_or(|f| f == 1)
+            && r.nv_lo.is_none()
+            && r.roughness_lo.is_none()
+            && r.near_sun.is_none()
+    };
+    let kept: Vec<Measurement> = rows.iter().filter(headline).cloned().collect();
+    panels(&kept)
+}
+
 /// A row's band, in words: roughness, `n·v`, near the sun.
 fn band(r: &Measurement) -> String {
     let mut parts = Vec::new();
@@ -94,10 +104,10 @@ fn part_name(p: Part) -> &'static str {
 }
 
 /// One of the report's tables: its title, header and cells.
-type Table = (String, [&'static str; 8], Vec<[String; 8]>);
+pub(crate) type Table = crate::figures::Table<8>;
 
 /// The report's tables: one per product, rows in measurement order.
-fn tables(rows: &[Measurement]) -> Vec<Table> {
+pub(crate) fn tables(rows: &[Measurement]) -> Vec<Table> {
     let mut products: Vec<Quantity> = rows.iter().filter(|r| r.set.is_none() && r.product != Quantity::ShadingCost).map(|r| r.product).collect();
     products.sort();
     products.dedup();
@@ -127,11 +137,11 @@ fn tables(rows: &[Measurement]) -> Vec<Table> {
 }
 
 /// What the measure over sets is, in the report.
-const SETS_NOTE: &str = "The end-to-end measure (shaded colour against the full reflectance integral, exact Smith, no split) over environments of every kind. Design choices may look at the tuning set only; the held-out set confirms them. Mean relative luminance error over each set's environments (the largest point in brackets).";
+pub(crate) const SETS_NOTE: &str = "The end-to-end measure (shaded colour against the full reflectance integral, exact Smith, no split) over environments of every kind. Design choices may look at the tuning set only; the held-out set confirms them. Mean relative luminance error over each set's environments (the largest point in brackets).";
 
 /// `mean (max)` over the environments of a set: the mean of their means, the largest of
 /// their maxima; `-` where no row matches.
-fn over_environments<'a>(rows: impl Iterator<Item = &'a Measurement>) -> String {
+pub(crate) fn over_environments<'a>(rows: impl Iterator<Item = &'a Measurement>) -> String {
     let (mut sum, mut n, mut max) = (0.0, 0usize, 0.0f64);
     for r in rows {
         sum += r.mean_error;
@@ -144,7 +154,7 @@ fn over_environments<'a>(rows: impl Iterator<Item = &'a Measurement>) -> String 
 /// The measure over sets: per set, each method's shaded colour over every point and per
 /// `n·v` band, the bake's share and the prefiltered lookup (mean over the set's
 /// environments, max in brackets); then each environment's figures for the defaults.
-fn set_tables(rows: &[Measurement]) -> Vec<Table> {
+pub(crate) fn set_tables(rows: &[Measurement]) -> Vec<Table> {
     use crate::measurement::Set;
     let set_rows: Vec<&Measurement> = rows.iter().filter(|r| r.set.is_some()).collect();
     if set_rows.is_empty() {
@@ -213,9 +223,9 @@ fn set_tables(rows: &[Measurement]) -> Vec<Table> {
 }
 
 /// What the shading ladder is, in the report.
-const BUDGET_NOTE: &str = "For each time budget per bake, the settings splitsum::estimate::for_budget chooses on this backend (by this backend's estimator, as runner bake --budget chooses: its rates measured now, the built-in error model): the sample count at mip 1 and the irradiance source. Each is baked, timed (the bake as run here, not the estimate) and measured end to end like the methods below: shaded colour against the full reflectance integral over this environment's points.";
+pub(crate) const BUDGET_NOTE: &str = "For each time budget per bake, the settings splitsum::estimate::for_budget chooses on this backend (by this backend's estimator, as runner bake --budget chooses: its rates measured now, the built-in error model): the sample count at mip 1 and the irradiance source. Each is baked, timed (the bake as run here, not the estimate) and measured end to end like the methods below: shaded colour against the full reflectance integral over this environment's points.";
 
-const LADDER_NOTE: &str = "The shading ladder: the split sum's one prefiltered fetch, then 2 to 16 fetches of filtered importance sampling of the true GGX lobe over the prefiltered mips (shade::lobe_radiance), used below n·v 0.7. Shaded colour against the full reflectance integral (mean relative luminance error, the largest point in brackets), against what a shaded pixel costs: ns per pixel of a sphere in the default view, direct lights included (a frame with the spheres less one without, best of three).";
+pub(crate) const LADDER_NOTE: &str = "The shading ladder: the split sum's one prefiltered fetch, then 2 to 16 fetches of filtered importance sampling of the true GGX lobe over the prefiltered mips (shade::lobe_radiance), used below n·v 0.7. Shaded colour against the full reflectance integral (mean relative luminance error, the largest point in brackets), against what a shaded pixel costs: ns per pixel of a sphere in the default view, direct lights included (a frame with the spheres less one without, best of three).";
 
 /// The method of the ladder's rung with `fetches`: the defaults' one fetch, the ladder above.
 pub fn rung_method(fetches: u32) -> Method {
@@ -261,7 +271,7 @@ fn rung_rows(rows: &[Measurement], fetches: u32) -> impl Iterator<Item = &Measur
 
 /// The ladder's table: per rung, its cost on each backend and its error on the report's
 /// environment and over each set, all points and per `n·v` band.
-fn ladder_table(rows: &[Measurement]) -> Option<Table> {
+pub(crate) fn ladder_table(rows: &[Measurement]) -> Option<Table> {
     let rungs = rungs(rows);
     if rungs.is_empty() {
         return None;
@@ -356,7 +366,7 @@ fn budget_rows(rows: &[Measurement], band: Option<f32>) -> impl Iterator<Item = 
 
 /// The budget curve's table: per backend and budget, the settings chosen, their estimated
 /// and measured bake time, and their error end to end.
-fn budget_table(rows: &[Measurement]) -> Option<Table> {
+pub(crate) fn budget_table(rows: &[Measurement]) -> Option<Table> {
     let cells: Vec<[String; 8]> = budget_rows(rows, None)
         .map(|r| {
             let grazing = budget_rows(rows, Some(0.1))
@@ -401,183 +411,4 @@ pub fn budget_panels(rows: &[Measurement]) -> Vec<crate::plot::LadderPanel> {
         }
     }
     panels
-}
-
-fn html_escape(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
-}
-
-pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep: &Sweep, rows: &[Measurement], maps: &[(String, ErrorMap)]) -> Result<()> {
-    files::write_atomic(&dir.join("report.csv"), |w| splitsum::measured::write_csv(w, rows).map_err(std::io::Error::other))?;
-    let svg = |w: &mut dyn std::io::Write, drawn: std::result::Result<String, Box<dyn std::error::Error>>| -> std::io::Result<()> {
-        w.write_all(drawn.map_err(|e| std::io::Error::other(e.to_string()))?.as_bytes())
-    };
-    files::write_atomic(&dir.join("error_vs_time.svg"), |w| svg(w, crate::plot::small_multiples(&panels(rows), 3)))?;
-    // surface{k}_splitsum.png, surface{k}_exact.png, surface{k}_error.png for each map.
-    let picture = |k: usize, kind: &str| format!("surface{k}_{kind}.png");
-    for (k, (_, map)) in maps.iter().enumerate() {
-        for (kind, rgb) in [("splitsum", &map.splitsum), ("exact", &map.exact), ("error", &map.error)] {
-            files::write_png(&dir.join(picture(k, kind)), map.width, map.height, rgb)?;
-        }
-    }
-    let ladder = ladder_table(rows);
-    if ladder.is_some() {
-        files::write_atomic(&dir.join("ladder.svg"), |w| svg(w, crate::plot::ladder(&ladder_panels(rows))))?;
-    }
-    let budget = budget_table(rows);
-    if budget.is_some() {
-        files::write_atomic(&dir.join("budget.svg"), |w| svg(w, crate::plot::ladder(&budget_panels(rows))))?;
-    }
-    files::write_atomic(&dir.join("surface_scale.svg"), |w| {
-        svg(w, crate::plot::colour_scale("relative luminance error", crate::surface::false_colour, &crate::surface::scale_ticks()))
-    })?;
-
-    let devices = backends.iter().map(|b| b.describe()).collect::<Vec<_>>().join("; ");
-    if let Some(headline) = crate::figures::headline(rows, &crate::figures::command_line(name), &backends[0].describe()) {
-        files::write_atomic(&dir.join("figures.md"), |w| std::io::Write::write_all(w, headline.as_bytes()))?;
-    }
-    let setup = format!(
-        "Environment: {name}; source cube {0}x{0}; prefiltered cube {1}x{1}, {2} mips (roughness m/(M-1)). Backends: {devices}.",
-        sweep.source_size, sweep.specular_size, sweep.mips
-    );
-    let references = "References (f64, independent of the code under test): adaptive Gauss-Kronrod quadrature for the BRDF table; exact sums over every texel of the source for the prefilter and the irradiance; the full reflectance integral (exact Smith, no split) for the shaded colour. Errors are relative: of the luminance, and for the table of the directional albedo F0*A + B (the larger of F0 = 0.04 and 1). Times are wall-clock, uploads and readbacks included.";
-    let grid = format!(
-        "Sphere grid (metal above, dielectric below; roughness {} across), orthographic view, shaded by splitsum from the default bake on {} against the exact integral (exact Smith, no split), with their relative luminance error.",
-        crate::surface::ROUGHNESS.iter().map(|r| format!("{r}")).collect::<Vec<_>>().join(", "),
-        backends[0].describe()
-    );
-    let caption = |what: &str, map: &ErrorMap| format!("{what}: mean relative error {:.2} %, max {:.0} %.", 100.0 * map.mean, 100.0 * map.max);
-    let tables = tables(rows);
-    let set_tables = set_tables(rows);
-    let best = best_per_ms(rows);
-
-    // Markdown.
-    let mut md = String::new();
-    let _ = writeln!(md, "# splitsum: error against run time\n\n{setup}\n\n{references}\n");
-    let _ = writeln!(md, "![error against run time](error_vs_time.svg)\n\n{grid}\n\n| environment | splitsum | exact | error |\n|---|---|---|---|");
-    for (k, (what, map)) in maps.iter().enumerate() {
-        let _ = writeln!(md, "| {} | ![]({}) | ![]({}) | ![]({}) |", caption(what, map), picture(k, "splitsum"), picture(k, "exact"), picture(k, "error"));
-    }
-    let _ = writeln!(md, "\n![scale](surface_scale.svg)");
-    let figures = [
-        (&ladder, LADDER_NOTE, "ladder", "the shading ladder", "error against ns per shaded pixel, one point per rung"),
-        (&budget, BUDGET_NOTE, "budget", "the budget curve", "error against the time budget, one point per budget"),
-    ];
-    for (table, note, id, alt, _) in figures {
-        if let Some((title, header, cells)) = table {
-            let _ = writeln!(md, "\n## {title}\n\n{note}\n\n![{alt}]({id}.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-            for c in cells {
-                let _ = writeln!(md, "| {} |", c.join(" | "));
-            }
-        }
-    }
-    if !set_tables.is_empty() {
-        let _ = writeln!(md, "\n## Tuning and held-out sets\n\n{SETS_NOTE}");
-    }
-    for (title, header, cells) in set_tables.iter().chain(&tables) {
-        let _ = writeln!(md, "\n## {title}\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-        for c in cells {
-            let _ = writeln!(md, "| {} |", c.join(" | "));
-        }
-    }
-    let _ = writeln!(
-        md,
-        "\n## Best error per millisecond (smallest mean error x time)\n\n| panel | backend | setting | time (ms) | mean error |\n|---|---|---|---:|---:|"
-    );
-    for (p, r) in &best {
-        let _ = writeln!(md, "| {p} | {} | {} | {:.1} | {:.2e} |", r.backend, r.setting(), r.time_ms.unwrap_or(f64::NAN), r.mean_error);
-    }
-    files::write_atomic(&dir.join("report.md"), |w| std::io::Write::write_all(w, md.as_bytes()))?;
-
-    // HTML: the same, every figure inline beside its caption.
-    let mut html = String::new();
-    let _ = writeln!(
-        html,
-        "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>splitsum: error against run time, {}</title>\n<style>body{{font-family:sans-serif;max-width:1120px;margin:2em auto;color:#222}} table{{border-collapse:collapse;font-size:13px;margin:0.5em 0 1.5em}} td,th{{border:1px solid #ccc;padding:2px 6px;text-align:right}} td:nth-child(-n+5),th:nth-child(-n+5){{text-align:left}} figure{{margin:1em 0}} .maps img{{image-rendering:pixelated;border:1px solid #ddd;margin-right:8px}}</style></head><body>",
-        html_escape(name)
-    );
-    let _ = writeln!(html, "<h1>splitsum: error against run time</h1>\n<p>{}</p>", html_escape(&setup));
-    // The headline first: the sets' figures (where measured) and the error against time;
-    // the details below it, collapsed.
-    if let Some((header, cells)) = crate::figures::headline_table(rows) {
-        let _ = writeln!(
-            html,
-            "<h2 id=\"headline\">Accuracy on the tuning and held-out sets</h2>\n<p>{}</p>\n<table><tr>{}</tr>",
-            html_escape(&crate::figures::provenance(&backends[0].describe())),
-            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
-        );
-        for c in cells {
-            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
-        }
-        let _ = writeln!(html, "</table>");
-    }
-    let _ = writeln!(
-        html,
-        "<figure id=\"error-vs-time\"><img src=\"error_vs_time.svg\" alt=\"error against run time, one panel per product\"><figcaption>Mean relative error against bake time, one panel per product: one colour per method, the GPU solid and the CPU dashed; ringed points are each panel's Pareto front.</figcaption></figure>"
-    );
-    let _ = writeln!(
-        html,
-        "<details><summary>Details: the references, the error on surfaces, the shading ladder, the budgets, the sets per environment and every product's table</summary>\n<p>{}</p>",
-        html_escape(references)
-    );
-    let _ = writeln!(html, "<h2>The error on surfaces</h2>\n<p>{}</p>", html_escape(&grid));
-    for (k, (what, map)) in maps.iter().enumerate() {
-        let _ = writeln!(
-            html,
-            "<figure class=\"maps\"><img src=\"{}\" alt=\"splitsum\"><img src=\"{}\" alt=\"exact\"><img src=\"{}\" alt=\"error\"><figcaption>Left to right: splitsum, the exact integral, their relative error. {}</figcaption></figure>",
-            picture(k, "splitsum"),
-            picture(k, "exact"),
-            picture(k, "error"),
-            html_escape(&caption(what, map))
-        );
-    }
-    let _ = writeln!(html, "<img src=\"surface_scale.svg\" alt=\"error scale\">");
-    for (table, note, id, _, alt) in figures {
-        if let Some((title, header, cells)) = table {
-            let _ = writeln!(
-                html,
-                "<h2 id=\"{id}\">{}</h2>\n<p>{}</p>\n<figure><img src=\"{id}.svg\" alt=\"{alt}\"></figure>\n<table><tr>{}</tr>",
-                html_escape(title),
-                html_escape(note),
-                header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
-            );
-            for c in cells {
-                let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
-            }
-            let _ = writeln!(html, "</table>");
-        }
-    }
-    if !set_tables.is_empty() {
-        let _ = writeln!(html, "<h2>Tuning and held-out sets</h2>\n<p>{}</p>", html_escape(SETS_NOTE));
-    }
-    for (title, header, cells) in set_tables.iter().chain(&tables) {
-        let _ = writeln!(
-            html,
-            "<h2>{}</h2>\n<table><tr>{}</tr>",
-            html_escape(title),
-            header.iter().map(|h| format!("<th>{}</th>", html_escape(h))).collect::<String>()
-        );
-        for c in cells {
-            let _ = writeln!(html, "<tr>{}</tr>", c.iter().map(|v| format!("<td>{}</td>", html_escape(v))).collect::<String>());
-        }
-        let _ = writeln!(html, "</table>");
-    }
-    let _ = writeln!(
-        html,
-        "<h2>Best error per millisecond</h2>\n<table><tr><th>panel</th><th>backend</th><th>setting</th><th>time (ms)</th><th>mean error</th></tr>"
-    );
-    for (p, r) in &best {
-        let _ = writeln!(
-            html,
-            "<tr><td>{}</td><td>{}</td><td>{}</td><td>{:.1}</td><td>{:.2e}</td></tr>",
-            html_escape(p),
-            r.backend,
-            html_escape(&r.setting()),
-            r.time_ms.unwrap_or(f64::NAN),
-            r.mean_error
-        );
-    }
-    let _ = writeln!(html, "</table></details></body></html>");
-    files::write_atomic(&dir.join("report.html"), |w| std::io::Write::write_all(w, html.as_bytes()))?;
-    Ok(())
 }

@@ -16,7 +16,7 @@
 //! (small multiples, [`crate::plot`]) and the error on surfaces ([`crate::surface`]).
 
 use crate::measurement::{Device, Knob, Measurement, Method, Metric, Part, Quantity, arr, rel};
-use crate::pages::write_outputs;
+use crate::write::write_outputs;
 use crate::sweep::{Sets, Sweep};
 use rayon::prelude::*;
 use splitsum::Product;
@@ -25,14 +25,14 @@ use splitsum::bake;
 use splitsum::environment::Environment;
 use splitsum::error::Result;
 use splitsum::files;
-use splitsum::settings::{Settings, level_of_size};
+use splitsum::settings::{Job, Settings, level_of_size};
 use splitsum::texture::Cube;
 use splitsum_reference as reference;
 use splitsum_shaders::brdf::microfacet::Masking;
 use splitsum_shaders::cubemap::{self, CubeLayout};
 use splitsum_shaders::glam::{Vec2, Vec3};
 use splitsum_shaders::irradiance::sh9_irradiance;
-use splitsum_shaders::prefilter::RoughnessMapping;
+use splitsum_shaders::prefilter::Lobe;
 use splitsum_shaders::shade::{self, Material, ShadeOptions};
 use splitsum_shaders::{lut, sampling};
 use std::path::Path;
@@ -72,9 +72,10 @@ pub fn run(
     let settings = Settings { source_size: Some(sweep.source_size), size: sweep.source_size, ..Settings::default() };
     let source = bake::host_source_cube(&Backend::Cpu, env, &settings)?;
     let texels = reference::texels(source.level(0), sweep.source_size);
+    let job = sweep.level_job()?;
     let refs = {
         let _step = splitsum::progress::step("report: references (f64)", None);
-        References::compute(sweep, &texels)
+        References::compute(sweep, &job, &texels)
     };
     let mut rows = Vec::new();
     rows.extend(refs.split_error_rows());
@@ -87,7 +88,7 @@ pub fn run(
         backend.prefilter(&source, CubeLayout::new(4, 1), &[0.5], 4, 0.0)?;
         backend.irradiance(&source, source.layout.levels - 1, 4)?;
         rows.extend(lut_rows(backend, &b, sweep, &refs)?);
-        rows.extend(prefilter_rows(backend, &b, sweep, &refs, &source)?);
+        rows.extend(prefilter_rows(backend, &b, sweep, &job, &refs, &source)?);
         rows.extend(irradiance_rows(backend, &b, sweep, &refs, &source)?);
         rows.extend(shaded_rows(backend, &b, sweep, &refs, env)?);
     }
@@ -172,7 +173,7 @@ struct ShadingPoint {
 }
 
 impl References {
-    fn compute(sweep: &Sweep, texels: &[([f64; 3], f64, [f64; 3])]) -> Self {
+    fn compute(sweep: &Sweep, job: &Job, texels: &[([f64; 3], f64, [f64; 3])]) -> Self {
         let t = sweep.lut_size;
         let lut: Vec<Vec2> = (0..t * t)
             .into_par_iter()
@@ -191,7 +192,7 @@ impl References {
             })
             .collect();
         let prefilter_dirs = directions(sweep.directions);
-        let roughness: Vec<f32> = (0..sweep.mips).map(|m| RoughnessMapping::Linear.roughness(m, sweep.mips)).collect();
+        let roughness = job.roughness_per_mip();
         let prefilter = roughness.iter().map(|&r| prefilter_dirs.par_iter().map(|&n| reference::prefilter(texels, arr(n), r as f64)).collect()).collect();
         let irradiance_dirs = directions(2 * sweep.directions);
         let irradiance = irradiance_dirs.par_iter().map(|&n| reference::irradiance(texels, arr(n))).collect();
@@ -295,28 +296,36 @@ fn lut_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References) -> 
     Ok(rows)
 }
 
-fn prefilter_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
+/// The prefiltered cube at the levels of [`Sweep::levels`] (the defaults at the report's
+/// size): each sampled mip's sample sweep (its default count among them) and bias sweep,
+/// mip 1's face-size sweep, and the default bake of the whole cube (`Knob::Quality`: each
+/// mip as the defaults make it, sampled with their growth or summed exactly, one timed
+/// dispatch whose time every mip's row carries).
+fn prefilter_rows(backend: &Backend, b: &Device, sweep: &Sweep, job: &Job, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
-    let roughness: Vec<f32> = (0..sweep.mips).map(|m| RoughnessMapping::Linear.roughness(m, sweep.mips)).collect();
+    let roughness = job.roughness_per_mip();
+    // Level `level` of `cube` against the reference of mip `m`'s roughness.
+    let errors_of = |cube: &Cube, level: u32, m: usize| -> Vec<f64> {
+        refs.prefilter_dirs.iter().zip(&refs.prefilter[m]).map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, cube.layout, level, d).truncate(), *r)).collect()
+    };
     let mut level = |n: u32, bias: f32, m: usize, size: u32, knob: Knob| -> Result<()> {
         let layout = CubeLayout::new(size, 1);
         let (cube, ms) = timed(|| backend.prefilter(source, layout, &[roughness[m]], n, bias))?;
-        let errors: Vec<f64> = refs
-            .prefilter_dirs
-            .iter()
-            .zip(&refs.prefilter[m])
-            .map(|(&d, r)| rel(cubemap::sample_bilinear(&cube.texels, layout, 0, d).truncate(), *r))
-            .collect();
-        let row = b.row(Quantity::Prefilter, Method::Defaults, &errors, Metric::RelativeLuminance);
+        let row = b.row(Quantity::Prefilter, Method::Defaults, &errors_of(&cube, 0, m), Metric::RelativeLuminance);
         let r = Some(roughness[m]);
         rows.push(Measurement { knob, samples: Some(n), bias: Some(bias), size: Some(size), roughness_lo: r, roughness_hi: r, time_ms: Some(ms), ..row });
         Ok(())
     };
-    let default_bias = Settings::default().lod_bias;
-    for (m, _) in roughness.iter().enumerate().skip(1) {
-        let size = (sweep.specular_size >> m).max(1);
-        for &n in &sweep.samples {
-            level(n, default_bias, m, size, Knob::Samples)?;
+    // The mirror (roughness 0) is a copy: nothing to sweep.
+    let sampled: Vec<usize> = (0..roughness.len()).filter(|&m| roughness[m] > 0.0).collect();
+    for &m in &sampled {
+        let size = (job.size >> m).max(1);
+        let mut counts = sweep.samples.clone();
+        counts.push(job.samples_per_mip[m]);
+        counts.sort_unstable();
+        counts.dedup();
+        for n in counts {
+            level(n, job.lod_bias, m, size, Knob::Samples)?;
         }
         for &n in &sweep.bias_samples {
             for &bias in &sweep.biases {
@@ -325,8 +334,19 @@ fn prefilter_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &Reference
         }
     }
     let n = sweep.bias_samples[sweep.bias_samples.len() - 1];
-    for &size in &sweep.cube_sizes {
-        level(n, default_bias, 1, size, Knob::Size)?;
+    if let Some(&first) = sampled.first() {
+        for &size in &sweep.cube_sizes {
+            level(n, job.lod_bias, first, size, Knob::Size)?;
+        }
+    }
+    let all: Vec<u32> = (0..job.mips).collect();
+    let (cube, ms) =
+        timed(|| backend.prefilter_levels(Lobe::Ggx, source, job.specular_layout(), roughness, &all, &job.samples_per_mip, true, job.lod_bias))?;
+    for m in sampled {
+        let row = b.row(Quantity::Prefilter, Method::Defaults, &errors_of(&cube, m as u32, m), Metric::RelativeLuminance);
+        let r = Some(roughness[m]);
+        let (samples, size) = (Some(job.samples_per_mip[m]), Some((job.size >> m).max(1)));
+        rows.push(Measurement { knob: Knob::Quality, samples, bias: Some(job.lod_bias), size, roughness_lo: r, roughness_hi: r, time_ms: Some(ms), ..row });
     }
     Ok(rows)
 }

@@ -11,10 +11,10 @@ use splitsum_shaders::shade::{self, ShadeOptions};
 pub struct Sweep {
     /// Face size of the source cube everything is filtered from (and the references sum).
     pub source_size: u32,
-    /// Face size of mip 0 of the prefiltered cube.
-    pub specular_size: u32,
-    /// Mips of the prefiltered cube (roughness `m/(M−1)`).
-    pub mips: u32,
+    /// The bake whose specular levels the prefilter sweeps measure: the defaults at the
+    /// report's size (face size, mips, roughness per mip, each mip's sample count, the
+    /// exact sums where they are cheaper), so that the sweeps sit around what a user bakes.
+    pub levels: Settings,
     /// Width of the BRDF table whose texel centres are compared.
     pub lut_size: u32,
     /// Sample counts swept for the table and the prefilter.
@@ -49,8 +49,8 @@ impl Sweep {
     /// measures the default bake settings (`Settings::default()`).
     pub fn full() -> Self {
         let mut sweep = Self::with(
-            128,
-            64,
+            256,
+            Settings::default().size,
             32,
             vec![16, 64, 256, 1024, 4096],
             vec![8, 16, 32, 64, 128],
@@ -67,6 +67,11 @@ impl Sweep {
     /// A quick report for CI: the same sweeps, smaller and shorter.
     pub fn quick() -> Self {
         let mut sweep = Self::with(16, 8, 8, vec![4, 16, 64], vec![4, 8, 16], vec![16], vec![4, 8], vec![4, 8, 16], vec![4, 8, 16], 8);
+        // Down to 1² faces: an 8² cube at the defaults would be the mirror alone.
+        sweep.levels.mips = Some(4);
+        for q in &mut sweep.qualities {
+            q.mips = Some(4);
+        }
         sweep.accuracy_source = 16;
         sweep.accuracy_points = (48, 48);
         sweep
@@ -115,6 +120,11 @@ impl Sweep {
         methods
     }
 
+    /// The job of [`Sweep::levels`]: its roughness per mip, sample counts and exact levels.
+    pub fn level_job(&self) -> splitsum::error::Result<splitsum::settings::Job> {
+        self.levels.resolve(splitsum::settings::InputShape::Unknown, splitsum::Products::DISPLAY)
+    }
+
     /// The methods the measure over sets compares: the seed at its 1024 samples, the
     /// defaults, and each shading option.
     pub fn set_methods(&self, native: u32) -> Vec<crate::accuracy::Method> {
@@ -141,13 +151,11 @@ impl Sweep {
         sh_sources: Vec<u32>,
         directions: u32,
     ) -> Self {
-        let mips = 4;
         let level = |n: u32, lut: u32, irr: u32| Settings {
             size: specular_size,
             source_size: Some(source_size),
-            mips: Some(mips),
             samples: n,
-            irradiance_size: (specular_size / 2).max(4),
+            irradiance_size: Settings::default().irradiance_size.min(specular_size / 2).max(4),
             irradiance_source: Some(irr.min(source_size)),
             sh_source: Some(source_size),
             lut_size: lut,
@@ -162,8 +170,7 @@ impl Sweep {
         ];
         Self {
             source_size,
-            specular_size,
-            mips,
+            levels: Settings { size: specular_size, source_size: Some(source_size), ..Settings::default() },
             lut_size,
             samples,
             lut_sizes,
@@ -171,7 +178,7 @@ impl Sweep {
             bias_samples,
             cube_sizes,
             irradiance_sources,
-            irradiance_size: (specular_size / 2).max(4),
+            irradiance_size: Settings::default().irradiance_size.min(specular_size / 2).max(4),
             sh_sources,
             qualities,
             directions,
