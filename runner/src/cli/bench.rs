@@ -29,9 +29,39 @@ pub(super) struct BenchArgs {
     /// Bake the sheen cube and tables too (their steps timed and modelled like the others).
     #[arg(long)]
     sheen: bool,
+    /// Time whole processes instead, as a user runs them: a child `runner bake ENV` with
+    /// these quality flags on each backend, N times after a warm-up, its wall time and its
+    /// peak memory as the kernel counts it (medians)
+    #[arg(long, value_name = "N")]
+    processes: Option<u32>,
+    /// With --processes: another program's commands (a shell command line each, run one
+    /// after another in a scratch folder, with $INPUT the environment's absolute path)
+    /// that take their turn with each run, for the median of the pairs' wall ratios, which
+    /// load on a shared machine leaves standing
+    #[arg(long, value_name = "COMMAND", requires = "processes")]
+    versus: Vec<String>,
+    /// With --processes: write the table, the command line, date, machine and commit to
+    /// this Markdown file (for the guide to include); only a file runner bench wrote is
+    /// replaced
+    #[arg(long, value_name = "FILE", requires = "processes")]
+    figures: Option<PathBuf>,
 }
 
-pub(super) fn bench(args: BenchArgs) -> anyhow::Result<()> {
+pub(super) fn bench(args: BenchArgs, raw: &[std::ffi::OsString]) -> anyhow::Result<()> {
+    if let Some(runs) = args.processes {
+        #[cfg(unix)]
+        return super::processes::run(&super::processes::Plan {
+            env: &args.env,
+            quality: super::processes::quality_tokens(raw),
+            sheen: args.sheen,
+            backends: &args.backends,
+            runs,
+            versus: &args.versus,
+            figures: args.figures.as_deref(),
+        });
+        #[cfg(not(unix))]
+        anyhow::bail!("--processes {runs}: whole-process timing needs a Unix system (wait4)");
+    }
     let settings = args.quality.settings();
     // What `runner bake` makes for this target, and the sheen products with `--sheen`.
     let products = settings.target.products().with_sheen(args.sheen);

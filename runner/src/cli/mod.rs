@@ -6,6 +6,8 @@ mod bench;
 mod default;
 mod lut;
 mod plan;
+#[cfg(unix)]
+mod processes;
 mod render;
 mod report;
 mod view;
@@ -491,7 +493,8 @@ where
     use clap::{CommandFactory, FromArgMatches};
     crate::bars::install();
     crate::files::remove_staging_on_interrupt();
-    let matches = Cli::command().try_get_matches_from(args)?;
+    let raw: Vec<std::ffi::OsString> = args.into_iter().map(Into::into).collect();
+    let matches = Cli::command().try_get_matches_from(&raw)?;
     let cli = Cli::from_arg_matches(&matches)?;
     // The flags written on the command line (not defaulted), as the user wrote them.
     let given: Vec<String> = matches
@@ -512,7 +515,7 @@ where
     let result = match cli.command {
         Some(Command::Lut(args)) => lut::lut(args, &given),
         Some(Command::Bake(args)) => bake::bake_command(args, &given),
-        Some(Command::Bench(args)) => bench::bench(args),
+        Some(Command::Bench(args)) => bench::bench(args, &raw),
         Some(Command::Render(args)) => render::render(args, &given),
         Some(Command::View(args)) => view::view(args, &given),
         Some(Command::Report(args)) => report::report(args),
