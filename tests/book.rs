@@ -168,29 +168,57 @@ fn the_readme_is_short() {
     assert!(n <= 200, "README.md has {n} lines");
 }
 
-/// The README's accuracy figures are those of `book/src/figures/sets.md`, which
-/// `runner report ENV --sets` writes (`figures.md`, with its date, machine and commit) and
-/// the accuracy chapter includes: held out, the defaults over every point, at `n·v ≥ 0.6`
-/// and at `n·v ≤ 0.1`, 16 fetches, and the seed's settings.
+/// The cell of a generated figures table (`book/src/figures/FILE`): the row that begins
+/// with `row` (after its bar, backticks aside), the column headed `column`, trimmed, bold marks dropped.
+fn figure_cell(file: &str, row: &str, column: &str) -> String {
+    let text = std::fs::read_to_string(root().join("book/src/figures").join(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let cells = |line: &str| -> Vec<String> { line.split('|').map(|c| c.trim().trim_matches('*').to_string()).collect() };
+    let header = cells(text.lines().find(|l| l.starts_with("| ")).unwrap_or_else(|| panic!("{file}: no table")));
+    let k = header.iter().position(|h| h == column).unwrap_or_else(|| panic!("{file}: no column {column:?} in {header:?}"));
+    // Rows are named without their code marks (a command's backticks).
+    let line = text.lines().find(|l| l.replace('`', "").starts_with(&format!("| {row}"))).unwrap_or_else(|| panic!("{file}: no row {row:?}"));
+    cells(line)[k].clone()
+}
+
+/// Every figure the README quotes is a cell of a generated file (`book/src/figures/`,
+/// written by `bash scripts/dev.sh figures` with its command, date, machine and commit),
+/// named by the comment right after it: `VALUE<!-- figure: FILE | ROW | COLUMN -->`, the
+/// value a number with an optional unit (`%`, `s`, `MiB`), bold or not. The test fails on
+/// a quote that differs from its cell; `SPLITSUM_BLESS=1` rewrites the quotes instead.
 #[test]
-fn the_readmes_accuracy_figures_are_the_generated_ones() {
-    let figures = std::fs::read_to_string(root().join("book/src/figures/sets.md")).unwrap();
-    let header: Vec<&str> = figures.lines().find(|l| l.starts_with("| method |")).expect("the table's header").split('|').map(str::trim).collect();
-    let cell = |method: &str, column: &str| -> String {
-        let row: Vec<&str> =
-            figures.lines().find(|l| l.starts_with(&format!("| {method}"))).unwrap_or_else(|| panic!("no row {method}")).split('|').map(str::trim).collect();
-        let k = header.iter().position(|h| *h == column).unwrap_or_else(|| panic!("no column {column}"));
-        row[k].to_string()
-    };
-    let readme = std::fs::read_to_string(root().join("README.md")).unwrap().replace('\n', " ");
-    for (method, column) in [
-        ("defaults (one fetch)", "held-out set: all"),
-        ("defaults (one fetch)", "held-out set: n·v 0.6–1"),
-        ("defaults (one fetch)", "held-out set: ≤ 0.1"),
-        ("defaults, 16 fetches", "held-out set: all"),
-        ("seed", "held-out set: all"),
-    ] {
-        let figure = cell(method, column);
-        assert!(readme.contains(&figure), "README.md does not quote {method}, {column}: {figure}");
+fn the_readmes_figures_are_the_generated_ones() {
+    let path = root().join("README.md");
+    let text = std::fs::read_to_string(&path).unwrap();
+    const MARK: &str = "<!-- figure: ";
+    let (mut out, mut rest, mut quotes, mut wrong) = (String::new(), text.as_str(), 0, Vec::new());
+    while let Some(at) = rest.find(MARK) {
+        let (before, after) = rest.split_at(at);
+        let end = after.find(" -->").expect("a figure comment ends");
+        let spec: Vec<&str> = after[MARK.len()..end].split(" | ").collect();
+        assert_eq!(spec.len(), 3, "figure comment {:?}: FILE | ROW | COLUMN", &after[..end]);
+        // The quote before the comment: `**`? number, then an optional unit, then `**`?.
+        let body = before.strip_suffix("**").unwrap_or(before);
+        let unit = [" %", " s", " MiB"].into_iter().find(|u| body.ends_with(u)).unwrap_or("");
+        let number = body[..body.len() - unit.len()].chars().rev().take_while(|c| c.is_ascii_digit() || *c == '.').count();
+        let start = body.len() - unit.len() - number;
+        assert!(number > 0, "no number before {:?}", &after[..end]);
+        let quoted = &body[start..];
+        let cell = figure_cell(spec[0], spec[1], spec[2]);
+        if quoted != cell {
+            wrong.push(format!("{} | {} | {}: README says {quoted:?}, the file {cell:?}", spec[0], spec[1], spec[2]));
+        }
+        out.push_str(&before[..start]);
+        out.push_str(&cell);
+        out.push_str(&before[start + quoted.len()..]);
+        out.push_str(&after[..end + 4]);
+        rest = &after[end + 4..];
+        quotes += 1;
+    }
+    out.push_str(rest);
+    assert!(quotes >= 11, "the README quotes {quotes} generated figures, fewer than its three headline figures need");
+    if std::env::var_os("SPLITSUM_BLESS").is_some() {
+        std::fs::write(&path, out).unwrap();
+    } else {
+        assert!(wrong.is_empty(), "README.md differs from the generated figures (SPLITSUM_BLESS=1 rewrites it):\n{}", wrong.join("\n"));
     }
 }

@@ -223,7 +223,10 @@ fn check(words: &[String], said: &str) -> Result<(), String> {
                 return Err(format!("{said}: bash {} exits {:?} in a dry run:\n{printed}", rest.join(" "), o.status.code()));
             }
             for line in printed.lines().filter_map(|l| l.strip_prefix("dry-run: ")) {
-                let inner: Vec<String> = line.split_whitespace().map(|s| s.replace('\\', "")).collect();
+                // The scripts print with `printf %q`: split as the shell would.
+                let Some(inner) = shlex::split(line) else {
+                    return Err(format!("{said}, via {script}: does not split as shell words: {line}"));
+                };
                 check(&inner, &format!("{said}, via {script}"))?;
             }
             Ok(())
@@ -237,8 +240,25 @@ fn check(words: &[String], said: &str) -> Result<(), String> {
             Some(dir) if root().join(dir).join("book.toml").is_file() => Ok(()),
             _ => Err(format!("{said}: mdbook is not given a folder with book.toml")),
         },
+        // Folders and copies inside the checkout (the figures the scripts regenerate).
+        Some("mkdir") | Some("cp") => match rest.iter().find(|a| !a.starts_with('-') && !inside_checkout(a)) {
+            None => Ok(()),
+            Some(a) => Err(format!("{said}: {a} is not a path inside the checkout")),
+        },
+        // One of the workspace's examples, built by an earlier command of the script.
+        Some(p) if p.starts_with("target/release/examples/") => {
+            let name = &p["target/release/examples/".len()..];
+            let found = ["runner", "splitsum", "display", "report"].iter().any(|c| root().join(c).join("examples").join(format!("{name}.rs")).is_file());
+            if found { Ok(()) } else { Err(format!("{said}: no example is named {name}")) }
+        }
         other => Err(format!("{said}: not a command this test knows: {other:?}")),
     }
+}
+
+/// A relative path with no `..` that stays in the checkout once its folders exist.
+fn inside_checkout(path: &str) -> bool {
+    let p = std::path::Path::new(path);
+    p.is_relative() && p.components().all(|c| matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir))
 }
 
 #[test]

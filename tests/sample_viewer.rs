@@ -116,12 +116,20 @@ fn the_sample_viewer_renders_the_khronos_folder() {
         (d[d.len() / 2], d.iter().sum::<f64>() / d.len() as f64)
     };
     let names = ["the renderer's own filtering", "splitsum's folder", "glTF-IBL-Sampler's folder"];
+    let mut figure = support::figure::Figure::new(
+        "sample-viewer",
+        "bash scripts/dev.sh viewer",
+        &["model", "lit by", "against", "median luminance difference", "mean"],
+    );
     for (m, model) in ["with sheen", "without sheen"].iter().enumerate() {
         for (a, b) in [(1, 2), (1, 0), (2, 0)] {
             let (med, mean) = compare(&px[3 * m + a], &px[3 * m + b]);
             println!("{model}: {} against {}: median luminance difference {:.2} %, mean {:.2} %", names[a], names[b], 100.0 * med, 100.0 * mean);
+            figure.row(vec![format!("torus {model}"), names[a].into(), names[b].into(), format!("{:.2} %", 100.0 * med), format!("{:.2} %", 100.0 * mean)]);
         }
     }
+    figure.note(format!("The glTF Sample Viewer's renderer (`@khronosgroup/gltf-viewer`) in headless Chromium, WebGL2 on SwiftShader, {} model pixels of {w}×{h} frames; luminance of the 8-bit frames, linearised.", model_px.len()));
+    figure.write();
     println!("{} model pixels, 6 frames in {:.1} s", model_px.len(), t.elapsed().as_secs_f64());
     let (med, mean) = compare(&px[4], &px[5]);
     assert!(med <= 0.005 && mean <= 0.02, "without sheen the two folders render differently: median {med}, mean {mean}");

@@ -414,6 +414,12 @@ fn the_default_sheen_cube_on_a_sunny_sky() {
         state = state.wrapping_mul(1664525).wrapping_add(1013904223);
         (state >> 8) % m
     };
+    let seconds = t.elapsed().as_secs_f64();
+    let mut figure = support::figure::Figure::new(
+        "sheen-sunny",
+        "cargo test --release -p splitsum-tests --test suite sheen::the_default_sheen_cube_on_a_sunny_sky",
+        &["mip", "sheen roughness", "mean relative error", "worst texel"],
+    );
     let mut errs = Vec::new();
     for (m, &r) in roughness.iter().enumerate() {
         let s = sheen.layout.level_size(m as u32);
@@ -430,8 +436,15 @@ fn the_default_sheen_cube_on_a_sunny_sky() {
         let mean = errors.iter().sum::<f64>() / errors.len() as f64;
         let worst = errors.iter().copied().fold(0.0, f64::max);
         println!("sheen mip {m} (sheen roughness {r:.2}): mean relative error {:.2} %, worst {:.1} %", 100.0 * mean, 100.0 * worst);
+        figure.row(vec![format!("{m}"), format!("{r:.2}"), format!("{:.2} %", 100.0 * mean), format!("{:.0} %", 100.0 * worst)]);
         errs.push(mean);
     }
+    figure.note(format!(
+        "The default sheen cube ({}², {} mips, CPU backend, {seconds:.2} s for the whole bake) of a held-out sky with a sun of 5·10⁴ (Gaussian, σ = 0.02 rad, 8° up), 1024×512, against the product quadrature of the analytic sky in the lobe's own coordinates (`reference::sheen::prefilter_of`), 160 texels a mip.",
+        sheen.layout.size,
+        sheen.layout.levels
+    ));
+    figure.write();
     // Held today: the horizon ring (mip 0, 2.9 %) and the exact sum of the roughest mip
     // (1.6 %). Not yet: mips 1–4 (sheen roughness 0.2–0.8) are sampled, 64–512 samples whose
     // footprints (the source level each reads) reach the sun where the lobe's weight is

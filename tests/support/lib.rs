@@ -2,6 +2,7 @@
 //! formulas and other integration rules than the code under test), error measures, and
 //! the GPU backend opened once per test binary.
 
+pub mod figure;
 pub mod model;
 
 pub use splitsum_reference as reference;
