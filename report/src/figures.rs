@@ -82,12 +82,20 @@ pub fn headline(rows: &[Measurement], command: &str, device: &str) -> Option<Str
     let (header, cells) = headline_table(rows)?;
     let mut md = String::new();
     let _ = writeln!(md, "<!-- Written by `{command}` (report/src/figures.rs); regenerate it, do not edit it. -->\n");
-    let _ = writeln!(md, "| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-    for row in cells {
-        let _ = writeln!(md, "| {} |", row.join(" | "));
-    }
+    md += &markdown_table(&header, &cells);
     let _ = writeln!(md, "\n{}", provenance(device));
     Some(md)
+}
+
+/// A Markdown table: the header row, its rule, and a row per entry of `rows`, each line
+/// ended by a newline.
+pub fn markdown_table<H: AsRef<str>, C: AsRef<str>>(header: &[H], rows: impl IntoIterator<Item = impl AsRef<[C]>>) -> String {
+    let line = |cells: &[C]| cells.iter().map(AsRef::as_ref).collect::<Vec<_>>().join(" | ");
+    let mut md = format!("| {} |\n|{}\n", header.iter().map(AsRef::as_ref).collect::<Vec<_>>().join(" | "), "---|".repeat(header.len()));
+    for row in rows {
+        md += &format!("| {} |\n", line(row.as_ref()));
+    }
+    md
 }
 
 /// A table: its title, header and cells.
@@ -102,10 +110,8 @@ pub fn figure_file<const N: usize>(command: &str, device: &str, note: &str, tabl
         if tables.len() > 1 {
             let _ = writeln!(md, "\n**{title}**");
         }
-        let _ = writeln!(md, "\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-        for row in cells {
-            let _ = writeln!(md, "| {} |", row.join(" | "));
-        }
+        let _ = writeln!(md);
+        md += &markdown_table(header, cells);
     }
     if !note.is_empty() {
         let _ = writeln!(md, "\n{note}");

@@ -105,20 +105,16 @@ pub(crate) fn write_outputs(dir: &Path, name: &str, backends: &[Backend], sweep:
     ];
     for (table, note, id, alt, _) in figures {
         if let Some((title, header, cells)) = table {
-            let _ = writeln!(md, "\n## {title}\n\n{note}\n\n![{alt}]({id}.svg)\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-            for c in cells {
-                let _ = writeln!(md, "| {} |", c.join(" | "));
-            }
+            let _ = writeln!(md, "\n## {title}\n\n{note}\n\n![{alt}]({id}.svg)\n");
+            md += &crate::figures::markdown_table(header, cells);
         }
     }
     if !set_tables.is_empty() {
         let _ = writeln!(md, "\n## Tuning and held-out sets\n\n{SETS_NOTE}");
     }
     for (title, header, cells) in set_tables.iter().chain(&tables) {
-        let _ = writeln!(md, "\n## {title}\n\n| {} |\n|{}", header.join(" | "), "---|".repeat(header.len()));
-        for c in cells {
-            let _ = writeln!(md, "| {} |", c.join(" | "));
-        }
+        let _ = writeln!(md, "\n## {title}\n");
+        md += &crate::figures::markdown_table(header, cells);
     }
     let _ = writeln!(
         md,

@@ -47,10 +47,7 @@ impl Figure {
             return;
         }
         let mut md = format!("<!-- Written by `{}` with SPLITSUM_FIGURES=1 (bash scripts/dev.sh figures); regenerate it, do not edit it. -->\n\n", self.test);
-        md += &format!("| {} |\n|{}\n", self.header.join(" | "), "---|".repeat(self.header.len()));
-        for r in &self.rows {
-            md += &format!("| {} |\n", r.join(" | "));
-        }
+        md += &splitsum_report::figures::markdown_table(&self.header, &self.rows);
         for n in &self.notes {
             md += &format!("\n{n}\n");
         }
