@@ -445,11 +445,12 @@ fn the_default_sheen_cube_on_a_sunny_sky() {
         sheen.layout.levels
     ));
     figure.write();
-    // Held today: the horizon ring (mip 0, 2.9 %) and the exact sum of the roughest mip
-    // (1.6 %). Not yet: mips 1–4 (sheen roughness 0.2–0.8) are sampled, 64–512 samples whose
-    // footprints (the source level each reads) reach the sun where the lobe's weight is
-    // small, 34–204 % off (issue 35 stays open on it); bound at 3 % once they are not.
-    let last = errs.len() - 1;
-    assert!(errs[0] <= 0.03, "the horizon ring: {:.2} %", 100.0 * errs[0]);
-    assert!(errs[last] <= 0.02, "sheen roughness 1: {:.2} %", 100.0 * errs[last]);
+    // The issue's targets: within 3 % at every mip, within 1 % at sheen roughness ≥ 0.7.
+    // Measured: 2.89 % at the ring (mip 0, 64 samples of the horizon, the sun in none of
+    // the split's terms), 0.13–0.46 % at mips 1–5 (the source split: `bright`).
+    for (m, (&e, &r)) in errs.iter().zip(roughness.iter()).enumerate() {
+        let bound = if r >= 0.7 { 0.01 } else { 0.03 };
+        assert!(e <= bound, "sheen mip {m} (roughness {r:.2}): {:.2} % against {:.0} %", 100.0 * e, 100.0 * bound);
+    }
 }
+

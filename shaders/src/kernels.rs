@@ -234,6 +234,22 @@ pub fn prefilter_exact(
     }
 }
 
+/// One chunk of the excess list of a split source (`bright::accumulate`, entries
+/// `start .. start + count` of `list`) added to the sums of one texel of one level of the
+/// sheen cube, after its samples of the residual ([`prefilter_specular`] over it).
+#[spirv(compute(threads(8, 8)))]
+pub fn prefilter_bright(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &PrefilterParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] list: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] accum: &mut [Vec4],
+) {
+    if let Some((_, i, n)) = prefilter_invocation(id, p) {
+        let partial = load_partial(accum, i);
+        store_partial(accum, i, crate::bright::accumulate(list, n, Lobe::from_u32(p.lobe).alpha(p.roughness), p.start, p.count, partial));
+    }
+}
+
 /// The index of the cube texel an invocation `id` of a `size`² × 6 dispatch works on
 /// (face `id.z`, column `id.x`, row `id.y`), `offset` texels into its buffer; nothing for
 /// the invocations past the faces' edges.

@@ -15,6 +15,7 @@
 #![no_std]
 
 pub mod brdf;
+pub mod bright;
 pub mod calibrate;
 pub mod choice;
 pub mod cubemap;

@@ -392,13 +392,20 @@ impl MeanPartial {
     /// shader, a closure that holds a storage-buffer slice does not validate (naga).
     #[inline]
     pub fn chunked(terms: u32, add: impl Fn(u32, u32, MeanPartial) -> MeanPartial) -> Vec4 {
-        let mut p = MeanPartial::default();
+        MeanPartial::default().then_chunked(terms, add).resolve()
+    }
+
+    /// These sums continued by a sum of `terms` terms run as [`MeanPartial::chunked`] runs
+    /// them: the next dispatches on the same sums.
+    #[inline]
+    pub fn then_chunked(self, terms: u32, add: impl Fn(u32, u32, MeanPartial) -> MeanPartial) -> MeanPartial {
+        let mut p = self;
         let mut start = 0u32;
         while start < terms {
             let c = if terms - start < CHUNK { terms - start } else { CHUNK };
             p = add(start, c, p);
             start += c;
         }
-        p.resolve()
+        p
     }
 }

@@ -26,7 +26,8 @@
 //! **The sheen cube** ([`Lobe::Charlie`]) is the same mean with the Charlie distribution
 //! in place of GGX (glTF-IBL-Sampler's `-distribution Charlie`): its samples and weights
 //! are `brdf::sheen`'s ([`charlie_sample`]). It has no mirror: at sheen roughness 0 the lobe
-//! is the horizon ring, which its samples trace.
+//! is the horizon ring, which its samples trace. Its other sampled levels read a split
+//! source: the brightest texels summed exactly, the rest sampled (`crate::bright`).
 
 use crate::brdf::{alpha_from_roughness, microfacet, sheen};
 use crate::cubemap::{self, CubeLayout};

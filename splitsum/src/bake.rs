@@ -220,7 +220,7 @@ pub fn products<K: Kernels>(k: &K, source: K::Texels, source_layout: CubeLayout,
 /// by [`source_cube`]): a prefiltered cube of any lobe by the backend's prefilter.
 fn make_product<K: Kernels>(k: &K, p: Product, source: &K::Texels, source_layout: CubeLayout, job: &Job) -> Result<Item<K::Texels>> {
     Ok(match p {
-        p if p.lobe().is_some() => Item::Cube(k.prefilter(source, source_layout, &prefilter(job, p))?),
+        p if p.lobe().is_some() => Item::Cube(crate::backend::split::prefilter(k, source, source_layout, &prefilter(job, p))?),
         Product::Irradiance => Item::Cube(k.irradiance(source, source_layout, job.irradiance_level(), job.irradiance_size)?),
         Product::Sh9 => Item::Coefficients(Box::new(k.sh9(source, source_layout, job.sh_level())?)),
         // Constants (`crate::table`): embedded or computed once per process, then uploaded.

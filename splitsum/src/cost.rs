@@ -174,7 +174,8 @@ pub fn product_bytes(job: &Job) -> u64 {
 /// Floating-point operations are estimates, counted by reading the shared functions once:
 /// about 140 per GGX sample (the half vector ≈ 50, the lookup ≈ 70, the compensated sum
 /// ≈ 20; a Charlie sample ≈ 330, its three Newton steps ≈ 190 in place of the half vector's
-/// 50), 80 per equirect area sample, 90 per term of an exact specular sum (texel
+/// 50), 40 per term of a split source's excess list (a dot product, a power, a compensated
+/// sum), 80 per equirect area sample, 90 per term of an exact specular sum (texel
 /// direction, solid angle, weight, compensated sum), 31 per irradiance term (its direction
 /// and solid angle read from a table: weight 7, compensated sums 24), 130 per SH9 texel. Bytes are the texels read and written (16 each).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -240,6 +241,12 @@ pub fn work(p: Product, job: &Job) -> Work {
                     let samples = texels * job.samples_per_mip[m] as f64;
                     w.filtered_reads += 8.0 * samples;
                     w.flops += p.flops_per_sample() * samples;
+                }
+                if splitsum_shaders::bright::splits(lobe, cube.roughness_per_mip[m], source.size) {
+                    // The excess list: at most `split::TEXELS` terms a texel, two texels each.
+                    let terms = texels * crate::backend::split::TEXELS as f64;
+                    w.summed_reads += 2.0 * terms;
+                    w.flops += 40.0 * terms;
                 }
                 w.bytes += 16.0 * texels;
             }

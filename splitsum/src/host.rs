@@ -114,7 +114,7 @@ impl Backend {
             self.placed("the prefiltered cube", needs, |b| {
                 with_kernels!(b, k => {
                     let t = k.upload("source cube", &src.texels)?;
-                    Ok(Cube { layout: out, texels: k.read(&k.prefilter(&t, src.layout, &job)?)? })
+                    Ok(Cube { layout: out, texels: k.read(&crate::backend::split::prefilter(k, &t, src.layout, &job)?)? })
                 })
             })
         }

@@ -185,6 +185,20 @@ pub fn charlie_light_weight(n_dot_l: f32, alpha: f32) -> f32 {
     math::pow(math::saturate(1.0 - n_dot_l), 0.5 / alpha)
 }
 
+/// The sheen prefilter's normalised density over light directions at `n·l` (with `v = n`):
+/// `b(b + 1)/(2π) · u(1 − u)^(b−1)`, `u = n·l`, `b = 1 + 1/(2α)` (the density of
+/// [`charlie_light_sample`], see there), zero below the horizon. Its integral over the
+/// hemisphere is 1, so `Σⱼ Lⱼ·pdf(lⱼ)·Ωⱼ` over texels is the lobe's mean of their radiance.
+#[cfg_attr(target_arch = "spirv", inline(never))]
+#[cfg_attr(not(target_arch = "spirv"), inline)]
+pub fn charlie_light_pdf(n_dot_l: f32, alpha: f32) -> f32 {
+    if n_dot_l <= 0.0 {
+        return 0.0;
+    }
+    let b = 1.0 + 0.5 / alpha;
+    b * (b + 1.0) / math::TAU * math::saturate(n_dot_l) * charlie_light_weight(n_dot_l, alpha)
+}
+
 /// The width, in `n·l` (about radians of elevation near the horizon), of the sheen
 /// prefilter's ring: its mean `n·l`, `4α/(1 + 4α)`.
 #[inline]

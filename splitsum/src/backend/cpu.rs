@@ -2,6 +2,7 @@
 //! over every texel with rayon, with a progress bar on work that takes a while.
 
 use super::kernels::{Kernels, Prefilter, chunks};
+use super::split::Split;
 use crate::error::Result;
 use crate::progress::{Bar, bar as progress};
 use crate::texture::{Equirect, Sh9};
@@ -13,7 +14,8 @@ use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance;
 use splitsum_shaders::kernels::{self, ProbeParams};
 use splitsum_shaders::calibrate::{self, Rate};
-use splitsum_shaders::{equirect, lut, prefilter};
+use splitsum_shaders::math::MeanPartial;
+use splitsum_shaders::{bright, equirect, lut, prefilter};
 
 /// The CPU backend (rayon's global thread pool).
 #[derive(Copy, Clone, Debug, Default)]
@@ -121,7 +123,7 @@ impl Kernels for Cpu {
         Ok(())
     }
 
-    fn prefilter(&self, src: &Vec<Vec4>, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Vec<Vec4>> {
+    fn prefilter(&self, src: &Vec<Vec4>, src_layout: CubeLayout, job: &Prefilter<'_>, split: Option<&Split<Vec<Vec4>>>) -> Result<Vec<Vec4>> {
         let out = job.layout;
         let mut texels = vec![Vec4::ZERO; out.texel_count() as usize];
         let rows: u64 = job.levels.iter().map(|&m| (FACES * out.level_size(m)) as u64).sum();
@@ -131,7 +133,26 @@ impl Kernels for Cpu {
             let start = out.level_offset(m) as usize;
             let level = &mut texels[start..start + (FACES * s * s) as usize];
             let (r, n, e) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
-            if e == prefilter::SAMPLED && !job.lobe.is_mirror(r) && job.lobe.alpha(r) > 0.0 {
+            if let Some(split) = split.filter(|_| bright::splits(job.lobe, r, src_layout.size)) {
+                // The residual sampled (its samples made once for the level) or summed over
+                // its level of the exact sum's size, then the excess.
+                let table: Vec<Vec4> =
+                    if e == prefilter::SAMPLED { prefilter::lobe_samples(job.lobe, n, r, split.layout.size, job.lod_bias).collect() } else { Vec::new() };
+                let residual_level = split.level_of(src_layout, e);
+                let terms = split.terms(e, residual_level, n);
+                let alpha = job.lobe.alpha(r);
+                fill_level(level, s, &bar, |face, x, y| {
+                    let d = cubemap::texel_dir(face, x, y, s);
+                    let p = MeanPartial::default().then_chunked(terms, |start, c, p| {
+                        if e == prefilter::SAMPLED {
+                            prefilter::accumulate_samples(job.lobe, &split.residual, split.layout, d, &table, start, c, p)
+                        } else {
+                            prefilter::exact_accumulate(job.lobe, &split.residual, split.layout, residual_level, d, r, start, c, p)
+                        }
+                    });
+                    p.then_chunked(split.entries, |start, c, p| bright::accumulate(&split.list, d, alpha, start, c, p)).resolve()
+                });
+            } else if e == prefilter::SAMPLED && !job.lobe.is_mirror(r) && job.lobe.alpha(r) > 0.0 {
                 // The samples depend on no texel: made once for the level.
                 let table: Vec<Vec4> = prefilter::lobe_samples(job.lobe, n, r, src_layout.size, job.lod_bias).collect();
                 fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_dir_samples(job.lobe, src, src_layout, cubemap::texel_dir(face, x, y, s), &table));

@@ -1,5 +1,6 @@
 //! The operations a bake is made of ([`Kernels`]), which each backend implements.
 
+use super::split::Split;
 use crate::error::Result;
 use crate::texture::{Equirect, Sh9};
 use splitsum_shaders::brdf::microfacet::Masking;
@@ -66,8 +67,9 @@ pub trait Kernels {
     fn equirect_to_cube(&self, env: &Equirect, size: u32, supersample: u32, facing: Facing) -> Result<Self::Texels>;
     /// Fills levels 1.. of `cube` from its level 0.
     fn build_mips(&self, cube: &mut Self::Texels, layout: CubeLayout) -> Result<()>;
-    /// The prefiltered cube of `job` (specular or sheen) from `src`.
-    fn prefilter(&self, src: &Self::Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Self::Texels>;
+    /// The prefiltered cube of `job` (specular or sheen) from `src`, the levels that split
+    /// (`bright::splits`) from `split` (made by `split::prefilter`, which callers call).
+    fn prefilter(&self, src: &Self::Texels, src_layout: CubeLayout, job: &Prefilter<'_>, split: Option<&Split<Self::Texels>>) -> Result<Self::Texels>;
     /// The irradiance cube (`E/π`) of faces of `size` from level `level` of `src`.
     fn irradiance(&self, src: &Self::Texels, src_layout: CubeLayout, level: u32, size: u32) -> Result<Self::Texels>;
     /// The per-row SH9 partial sums of level `level` of `src` (see `irradiance::sh9_row`).

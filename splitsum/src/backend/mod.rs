@@ -12,12 +12,14 @@
 pub mod cpu;
 pub mod gpu;
 pub mod kernels;
+pub mod split;
 
 use crate::error::Result;
 
 pub use cpu::Cpu;
 pub use gpu::Gpu;
 pub use kernels::{Kernels, Prefilter, chunks};
+pub use split::Split;
 
 /// Which backend to bake with.
 #[derive(Copy, Clone, Debug, PartialEq, Eq)]

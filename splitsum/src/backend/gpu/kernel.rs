@@ -64,6 +64,8 @@ kernels! {
     PREFILTER_SAMPLED = KERNELS_PREFILTER_SPECULAR(PrefilterParams);
     /// A chunk of a prefiltered level's exact sum over a source level.
     PREFILTER_EXACT = KERNELS_PREFILTER_EXACT(PrefilterParams);
+    /// The excess list of a split source added to a prefiltered cube's sums.
+    PREFILTER_BRIGHT = KERNELS_PREFILTER_BRIGHT(PrefilterParams);
     /// Means from chunks' partial sums.
     RESOLVE_MEANS = KERNELS_RESOLVE_MEANS(ResolveParams);
     /// A chunk of the irradiance convolution.

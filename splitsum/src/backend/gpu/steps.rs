@@ -5,6 +5,7 @@
 use super::kernel::{self, Kernel};
 use super::{Dispatch, Gpu};
 use crate::backend::kernels::{Kernels, Prefilter, chunks};
+use crate::backend::split::Split;
 use crate::error::{Error, Result};
 use crate::placement::{self, texel_bytes as bytes};
 use crate::texture::{Equirect, Sh9};
@@ -16,7 +17,7 @@ use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
 use splitsum_shaders::calibrate::Rate;
 use splitsum_shaders::kernels::{CalibrateParams, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, ResolveParams, TableParams};
-use splitsum_shaders::{equirect, lut, prefilter};
+use splitsum_shaders::{bright, equirect, lut, prefilter};
 
 /// Texels on the device: `count` RGBA f32 texels in `buffer`.
 pub struct Texels {
@@ -166,7 +167,7 @@ impl Kernels for Gpu {
         Ok(())
     }
 
-    fn prefilter(&self, src: &Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<Texels> {
+    fn prefilter(&self, src: &Texels, src_layout: CubeLayout, job: &Prefilter<'_>, split: Option<&Split<Texels>>) -> Result<Texels> {
         let out = job.layout;
         self.binds(&format!("the {} cube from the {}² source cube", job.what, src_layout.size), placement::sums_buffer(src.count as u64, out))?;
         let accum = self.output("prefilter sums", 3 * bytes(out.texel_count() as u64))?;
@@ -190,6 +191,23 @@ impl Kernels for Gpu {
             if job.lobe.is_mirror(r) {
                 // A mirror: the source read along each texel's direction, no sum.
                 self.run(&[kernel::PREFILTER_MIRROR.dispatch(&p, Some(&src.buffer), &result.buffer, [s, s, FACES])]);
+                continue;
+            }
+            if let Some(split) = split.filter(|_| bright::splits(job.lobe, r, src_layout.size)) {
+                // The residual's samples or exact sum, then the excess list, on the same sums.
+                let residual_level = split.level_of(src_layout, exact_level);
+                let exact_level = if exact_level == prefilter::SAMPLED { exact_level } else { residual_level };
+                let q = PrefilterParams { src_size: split.layout.size, src_levels: split.layout.levels, exact_level, ..p };
+                let kernel = if exact_level == prefilter::SAMPLED { &kernel::PREFILTER_SAMPLED } else { &kernel::PREFILTER_EXACT };
+                for (start, count) in chunks(split.terms(exact_level, residual_level, samples)) {
+                    let q = PrefilterParams { start, count, ..q };
+                    self.run(&[kernel.dispatch(&q, Some(&split.residual.buffer), &accum, [s, s, FACES])]);
+                }
+                for (start, count) in chunks(split.entries).filter(|&(_, c)| split.entries > 0 && c > 0) {
+                    let q = PrefilterParams { start, count, ..q };
+                    self.run(&[kernel::PREFILTER_BRIGHT.dispatch(&q, Some(&split.list.buffer), &accum, [s, s, FACES])]);
+                }
+                self.resolve(&accum, &result.buffer, out.level_offset(m), FACES * s * s);
                 continue;
             }
             // An exact sum runs over every texel of its source level, in chunks.

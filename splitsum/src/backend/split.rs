@@ -1,0 +1,126 @@
+//! The split of a source cube before the sheen prefilter (`splitsum_shaders::bright`: the
+//! brightest texels summed exactly, the rest sampled): which level, which threshold, and
+//! the residual cube with its mips on the backend. The filter itself is each backend's
+//! `Kernels::prefilter`.
+
+use super::kernels::{Kernels, Prefilter};
+use crate::error::Result;
+use splitsum_shaders::bright;
+use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
+use splitsum_shaders::glam::Vec4;
+
+/// The most texels of the split level summed exactly, `K` (`bright`'s module header).
+/// Measured with the level one coarser than an exact sum's (`split_size`) on the sunny sky
+/// of `tests/sheen.rs` (a 5·10⁴ sun): mips 1–5 within 0.46 % at 128 (the same at 256: the
+/// sun has fewer bright texels there), within 1.15 % at 64 a level coarser still, and at
+/// the exact sum's level 3.7 % at 128 against 0.25 % at 256; the three-sun sky of
+/// `sheen_cube_matches_the_exact_integral` agrees (mips 2–5 0.09–1.02 % against 0.11–1.28 %
+/// at the exact sum's level with 256). The list's terms are most of the split's cost.
+pub const TEXELS: u32 = 128;
+
+/// A source cube split for a prefilter: the residual (no texel brighter than the
+/// threshold) with its full mip chain in `layout`, and the excess list (`bright::ENTRY`
+/// texels per entry, `entries` of them).
+pub struct Split<T> {
+    /// The residual cube.
+    pub residual: T,
+    /// Its layout: the split level's faces, their full chain.
+    pub layout: CubeLayout,
+    /// The excess list.
+    pub list: T,
+    /// Entries in the list.
+    pub entries: u32,
+}
+
+impl<T> Split<T> {
+    /// The residual's level that stands for source level `exact_level` (of `src_layout`)
+    /// in an exact sum: the one of the same size (0 for a sampled level).
+    pub fn level_of(&self, src_layout: CubeLayout, exact_level: u32) -> u32 {
+        if exact_level == splitsum_shaders::prefilter::SAMPLED {
+            return 0;
+        }
+        level_of_size(self.layout, src_layout.level_size(exact_level))
+    }
+
+    /// Terms of the residual's sum for a level with `samples` samples, or summed exactly
+    /// (`exact_level` not `SAMPLED`) over the residual's level `residual_level`.
+    pub fn terms(&self, exact_level: u32, residual_level: u32, samples: u32) -> u32 {
+        if exact_level == splitsum_shaders::prefilter::SAMPLED { samples } else { FACES * self.layout.level_size(residual_level).pow(2) }
+    }
+}
+
+/// The level of `layout` whose faces are `face` wide (power-of-two sizes; the smallest
+/// level for a face smaller than that, the largest for one larger).
+fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
+    CubeLayout::full_chain(layout.size).saturating_sub(CubeLayout::full_chain(face)).min(layout.levels - 1)
+}
+
+/// Face size of the level `job` splits its source (faces of `src_size`) at, if any of
+/// its levels splits (`bright::splits`): one coarser than the exact sum's level for the
+/// sharpest of them (a texel a quarter of its ring's width; see [`TEXELS`]).
+pub fn split_size(job: &Prefilter<'_>, src_size: u32) -> Option<u32> {
+    job.levels
+        .iter()
+        .map(|&m| m as usize)
+        .filter(|&m| bright::splits(job.lobe, job.roughness[m], src_size))
+        .map(|m| splitsum_shaders::prefilter::exact_source_size(job.lobe, job.roughness[m], src_size))
+        .max()
+        .map(|t| (t / 2).max(1))
+}
+
+/// The threshold luminance of `level`: that of its `(TEXELS + 1)`-th brightest texel (of
+/// the finite ones), so that at most `TEXELS` are brighter; 0 for a level of no more.
+pub fn threshold(level: &[Vec4]) -> f32 {
+    let k = TEXELS as usize;
+    let mut lum: Vec<f32> = level.iter().map(|c| splitsum_shaders::tonemap::luminance(c.truncate())).filter(|l| l.is_finite()).collect();
+    if lum.len() <= k {
+        return 0.0;
+    }
+    let (_, t, _) = lum.select_nth_unstable_by(k, |a, b| b.total_cmp(a));
+    *t
+}
+
+/// `level` (faces of `size`, `FACES·size²` texels) split at [`threshold`]: the residual
+/// level and the excess list.
+pub fn split_level(level: &[Vec4], size: u32) -> (Vec<Vec4>, Vec<Vec4>) {
+    let t = threshold(level);
+    let mut list = Vec::new();
+    let residual = level
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| {
+            let (keep, excess) = bright::split_texel(c, t);
+            if excess != Vec4::ZERO {
+                list.push(cubemap::texel_geometry(i as u32, size));
+                list.push(excess);
+            }
+            keep
+        })
+        .collect();
+    (residual, list)
+}
+
+/// The prefiltered cube of `job` from `src` on `k`: the source split first where a level
+/// of `job` splits ([`split_size`]; its level read back, split, and the residual's mips
+/// built on `k`).
+pub fn prefilter<K: Kernels>(k: &K, src: &K::Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<K::Texels> {
+    let split = match split_size(job, src_layout.size) {
+        Some(t) => {
+            let level = level_of_size(src_layout, t);
+            let t = src_layout.level_size(level);
+            let n = FACES * t * t;
+            let texels = k.read(&k.slice(src, src_layout.level_offset(level), n)?)?;
+            let (mut residual, list) = split_level(&texels, t);
+            let layout = CubeLayout::new(t, CubeLayout::full_chain(t));
+            residual.resize(layout.texel_count() as usize, Vec4::ZERO);
+            let mut residual = k.upload("sheen residual", &residual)?;
+            k.build_mips(&mut residual, layout)?;
+            let entries = list.len() as u32 / bright::ENTRY;
+            // A buffer is never empty: an unused entry stands in for none.
+            let list = if list.is_empty() { vec![Vec4::ZERO; bright::ENTRY as usize] } else { list };
+            Some(Split { residual, layout, list: k.upload("sheen excess", &list)?, entries })
+        }
+        None => None,
+    };
+    k.prefilter(src, src_layout, job, split.as_ref())
+}
