@@ -26,10 +26,19 @@
 //! lie above the horizon, so `R̃`'s weights sum to 1 and the excess adds to the sum alone
 //! ([`accumulate`]).
 //!
-//! **Where.** A level splits where its lobe has a width (roughness above 0: the ring itself
-//! has none and is traced) that the source resolves ([`splits`]); a sampled level samples
-//! the residual, an exact one sums the residual's level of its size. The host picks the
-//! split level and `K` (`splitsum::backend::split`).
+//! **Where.** A level splits where its lobe has a width (roughness above 0) that the
+//! source resolves ([`splits`]); a sampled level samples the residual, an exact one sums
+//! the residual's level of its size. The host picks the split level and `K`
+//! (`splitsum::backend::split`).
+//!
+//! **The ring** (sheen roughness 0, `α → 0`): the mean of the radiance round the great
+//! circle `n·l = 0`. Of the residual, a continuous function of `n` (the circle's share of
+//! any bounded region moves continuously with it), it is traced at the split level's size
+//! and read bilinearly at the output's ([`ring_texel`]); of the excess, each texel is a disc
+//! of its solid angle, `ρ = √(Ω/π)`, which the circle at `u = n·l` crosses along a chord
+//! `2√(ρ² − u²)`: the texel adds `E·2√(ρ² − u²)/(2π)`. On the sunny sky of
+//! `tests/sheen.rs` that is 1.9 % off against 2.9 % for 64 samples of the ring at full
+//! size, at a sixteenth of the samples.
 
 use crate::brdf::sheen;
 use crate::math::{CompensatedSum4, MeanPartial};
@@ -85,4 +94,25 @@ pub fn accumulate(list: &[Vec4], n: Vec3, alpha: f32, start: u32, count: u32, p:
     }
     let (sum, carry) = acc.parts();
     MeanPartial { sum, carry, weight: p.weight }
+}
+
+/// Texel direction `n` of the sheen ring (sheen roughness 0) from a split source (see the
+/// module header): the residual's ring, a `ring_size`² one-level cube at the start of
+/// `buf`, read bilinearly along `n`, plus the chords of the `count` excess entries that
+/// follow it from index `list`.
+pub fn ring_texel(buf: &[Vec4], ring_size: u32, list: u32, count: u32, n: Vec3) -> Vec4 {
+    let n = sampling::normalize_or(n, Vec3::Z);
+    let mut acc = CompensatedSum4::new();
+    acc.add(crate::cubemap::sample_bilinear(buf, crate::cubemap::CubeLayout::new(ring_size, 1), 0, n));
+    let mut j = 0;
+    while j < count {
+        let g = buf[(list + ENTRY * j) as usize];
+        let u = n.dot(g.truncate());
+        let rho2 = g.w * (1.0 / crate::math::PI);
+        if u * u < rho2 {
+            acc.add(buf[(list + ENTRY * j + 1) as usize] * (crate::math::sqrt(rho2 - u * u) * (1.0 / crate::math::PI)));
+        }
+        j += 1;
+    }
+    crate::math::finite4(acc.total())
 }

@@ -250,6 +250,21 @@ pub fn prefilter_bright(
     }
 }
 
+/// One texel of the sheen ring (sheen roughness 0) from a split source
+/// (`bright::ring_texel`): `buf` holds the residual's ring, a `src_size`² cube, then from
+/// index `start` the `count` entries of the excess list; written at `dst_offset` on.
+#[spirv(compute(threads(8, 8)))]
+pub fn prefilter_ring(
+    #[spirv(global_invocation_id)] id: UVec3,
+    #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &PrefilterParams,
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] buf: &[Vec4],
+    #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
+) {
+    if let Some((_, i, n)) = prefilter_invocation(id, p) {
+        out[i] = crate::bright::ring_texel(buf, p.src_size, p.start, p.count, n);
+    }
+}
+
 /// The index of the cube texel an invocation `id` of a `size`² × 6 dispatch works on
 /// (face `id.z`, column `id.x`, row `id.y`), `offset` texels into its buffer; nothing for
 /// the invocations past the faces' edges.

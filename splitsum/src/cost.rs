@@ -228,11 +228,21 @@ pub fn work(p: Product, job: &Job) -> Work {
             let cube = &job.prefiltered[&p];
             let lobe = p.lobe().expect("a prefiltered cube has a lobe");
             let layout = job.specular_layout();
+            let split = crate::backend::split::split_size_of(lobe, &cube.roughness_per_mip, &cube.levels, source.size);
             for &l in &cube.levels {
                 let texels = faces(layout.level_size(l));
                 let m = l as usize;
                 if lobe.is_mirror(cube.roughness_per_mip[m]) {
                     w.filtered_reads += texels;
+                } else if let Some(rs) = split.filter(|_| crate::backend::split::is_ring(lobe, cube.roughness_per_mip[m])) {
+                    // The ring: sampled at the split level's size, then read (4 texels) with
+                    // the excess's chords (an entry read, a dot product and a comparison each,
+                    // most of them).
+                    let samples = faces(rs) * job.samples_per_mip[m] as f64;
+                    let chords = texels * crate::backend::split::TEXELS as f64;
+                    w.filtered_reads += 8.0 * samples + 4.0 * texels;
+                    w.summed_reads += chords;
+                    w.flops += p.flops_per_sample() * samples + 10.0 * chords;
                 } else if cube.exact_levels[m] != splitsum_shaders::prefilter::SAMPLED {
                     let terms = texels * faces(source.level_size(cube.exact_levels[m]));
                     w.summed_reads += terms;

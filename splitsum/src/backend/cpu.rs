@@ -133,7 +133,18 @@ impl Kernels for Cpu {
             let start = out.level_offset(m) as usize;
             let level = &mut texels[start..start + (FACES * s * s) as usize];
             let (r, n, e) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
-            if let Some(split) = split.filter(|_| bright::splits(job.lobe, r, src_layout.size)) {
+            if let Some(split) = split.filter(|_| super::split::is_ring(job.lobe, r)) {
+                // The residual's ring at the split level's size, then each texel read from
+                // it with the excess's chords.
+                let rs = split.layout.size;
+                let table: Vec<Vec4> = prefilter::lobe_samples(job.lobe, n, r, rs, job.lod_bias).collect();
+                let mut buf = vec![Vec4::ZERO; (FACES * rs * rs) as usize];
+                fill_level(&mut buf, rs, &Bar::hidden(), |face, x, y| {
+                    prefilter::prefilter_dir_samples(job.lobe, &split.residual, split.layout, cubemap::texel_dir(face, x, y, rs), &table)
+                });
+                buf.extend_from_slice(&split.list);
+                fill_level(level, s, &bar, |face, x, y| bright::ring_texel(&buf, rs, FACES * rs * rs, split.entries, cubemap::texel_dir(face, x, y, s)));
+            } else if let Some(split) = split.filter(|_| bright::splits(job.lobe, r, src_layout.size)) {
                 // The residual sampled (its samples made once for the level) or summed over
                 // its level of the exact sum's size, then the excess.
                 let table: Vec<Vec4> =

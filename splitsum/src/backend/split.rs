@@ -8,6 +8,7 @@ use crate::error::Result;
 use splitsum_shaders::bright;
 use splitsum_shaders::cubemap::{self, CubeLayout, FACES};
 use splitsum_shaders::glam::Vec4;
+use splitsum_shaders::prefilter::Lobe;
 
 /// The most texels of the split level summed exactly, `K` (`bright`'s module header).
 /// Measured with the level one coarser than an exact sum's (`split_size`) on the sunny sky
@@ -56,16 +57,30 @@ fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
 }
 
 /// Face size of the level `job` splits its source (faces of `src_size`) at, if any of
-/// its levels splits (`bright::splits`): one coarser than the exact sum's level for the
-/// sharpest of them (a texel a quarter of its ring's width; see [`TEXELS`]).
+/// its levels splits ([`split_size_of`]).
 pub fn split_size(job: &Prefilter<'_>, src_size: u32) -> Option<u32> {
-    job.levels
+    split_size_of(job.lobe, job.roughness, job.levels, src_size)
+}
+
+/// Face size of the level a cube of `lobe` whose mip `m` holds `roughness[m]`, baking
+/// `levels`, splits a source of faces `src_size` at, if any level splits
+/// (`bright::splits`): one coarser than the exact sum's level for the sharpest of them (a
+/// texel a quarter of its ring's width; see [`TEXELS`]). The ring (roughness 0) is then
+/// traced at this size too (`bright::ring_texel`).
+pub fn split_size_of(lobe: Lobe, roughness: &[f32], levels: &[u32], src_size: u32) -> Option<u32> {
+    levels
         .iter()
-        .map(|&m| m as usize)
-        .filter(|&m| bright::splits(job.lobe, job.roughness[m], src_size))
-        .map(|m| splitsum_shaders::prefilter::exact_source_size(job.lobe, job.roughness[m], src_size))
+        .map(|&m| roughness[m as usize])
+        .filter(|&r| bright::splits(lobe, r, src_size))
+        .map(|r| splitsum_shaders::prefilter::exact_source_size(lobe, r, src_size))
         .max()
         .map(|t| (t / 2).max(1))
+}
+
+/// Whether a level of `lobe` for `roughness` is the sheen ring, which a split source traces
+/// at the split level's size (`bright::ring_texel`).
+pub fn is_ring(lobe: Lobe, roughness: f32) -> bool {
+    lobe == Lobe::Charlie && roughness <= 0.0
 }
 
 /// The threshold luminance of `level`: that of its `(TEXELS + 1)`-th brightest texel (of

@@ -193,6 +193,26 @@ impl Kernels for Gpu {
                 self.run(&[kernel::PREFILTER_MIRROR.dispatch(&p, Some(&src.buffer), &result.buffer, [s, s, FACES])]);
                 continue;
             }
+            if let Some(split) = split.filter(|_| crate::backend::split::is_ring(job.lobe, r)) {
+                // The residual's ring at the split level's size into a buffer that holds the
+                // excess list after it, then each texel read from it with the list's chords.
+                let rs = split.layout.size;
+                let ring = FACES * rs * rs;
+                let buf = self.output("sheen ring", bytes((ring + split.list.count) as u64))?;
+                let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+                encoder.copy_buffer_to_buffer(&split.list.buffer, 0, &buf, bytes(ring as u64), bytes(split.list.count as u64));
+                self.queue.submit([encoder.finish()]);
+                let sums = self.output("sheen ring sums", 3 * bytes(ring as u64))?;
+                let q = PrefilterParams { src_size: rs, src_levels: split.layout.levels, dst_size: rs, dst_offset: 0, ..p };
+                for (start, count) in chunks(samples) {
+                    let q = PrefilterParams { start, count, ..q };
+                    self.run(&[kernel::PREFILTER_SAMPLED.dispatch(&q, Some(&split.residual.buffer), &sums, [rs, rs, FACES])]);
+                }
+                self.resolve(&sums, &buf, 0, ring);
+                let q = PrefilterParams { src_size: rs, start: ring, count: split.entries, ..p };
+                self.run(&[kernel::PREFILTER_RING.dispatch(&q, Some(&buf), &result.buffer, [s, s, FACES])]);
+                continue;
+            }
             if let Some(split) = split.filter(|_| bright::splits(job.lobe, r, src_layout.size)) {
                 // The residual's samples or exact sum, then the excess list, on the same sums.
                 let residual_level = split.level_of(src_layout, exact_level);
