@@ -223,9 +223,12 @@ impl Kernels for Gpu {
                     let q = PrefilterParams { start, count, ..q };
                     self.run(&[kernel.dispatch(&q, Some(&split.residual.buffer), &accum, [s, s, FACES])]);
                 }
-                for (start, count) in chunks(split.entries).filter(|&(_, c)| split.entries > 0 && c > 0) {
-                    let q = PrefilterParams { start, count, ..q };
-                    self.run(&[kernel::PREFILTER_BRIGHT.dispatch(&q, Some(&split.list.buffer), &accum, [s, s, FACES])]);
+                // `chunks` runs at least one chunk; an empty list needs none.
+                if split.entries > 0 {
+                    for (start, count) in chunks(split.entries) {
+                        let q = PrefilterParams { start, count, ..q };
+                        self.run(&[kernel::PREFILTER_BRIGHT.dispatch(&q, Some(&split.list.buffer), &accum, [s, s, FACES])]);
+                    }
                 }
                 self.resolve(&accum, &result.buffer, out.level_offset(m), FACES * s * s);
                 continue;
