@@ -25,7 +25,7 @@ use splitsum::bake;
 use splitsum::environment::Environment;
 use splitsum::error::Result;
 use splitsum::files;
-use splitsum::settings::{Job, Settings, level_of_size};
+use splitsum::settings::{Job, Settings};
 use splitsum::texture::Cube;
 use splitsum_reference as reference;
 use splitsum_shaders::brdf::microfacet::Masking;
@@ -354,7 +354,7 @@ fn prefilter_rows(backend: &Backend, b: &Device, sweep: &Sweep, job: &Job, refs:
 fn irradiance_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, source: &Cube) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
     for &s in &sweep.irradiance_sources {
-        let level = level_of_size(source.layout, s);
+        let level = source.layout.level_of_size(s);
         let (cube, ms) = timed(|| backend.irradiance(source, level, sweep.irradiance_size))?;
         let errors: Vec<f64> = refs
             .irradiance_dirs
@@ -366,7 +366,7 @@ fn irradiance_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &Referenc
         rows.push(Measurement { knob: Knob::SourceSize, source_size: Some(s), size: Some(sweep.irradiance_size), time_ms: Some(ms), ..row });
     }
     for &s in &sweep.sh_sources {
-        let level = level_of_size(source.layout, s);
+        let level = source.layout.level_of_size(s);
         let (sh, ms) = timed(|| backend.sh9(source, level))?;
         let coeffs = sh.as_vec4();
         let errors: Vec<f64> = refs.irradiance_dirs.iter().zip(&refs.irradiance).map(|(&d, r)| rel(sh9_irradiance(&coeffs, d), *r)).collect();

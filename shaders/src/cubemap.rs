@@ -76,6 +76,17 @@ impl CubeLayout {
         }
     }
 
+    /// The first level whose faces are at most `face` wide (the level of that size in a
+    /// power-of-two chain), or the last level if none is.
+    #[inline]
+    pub fn level_of_size(&self, face: u32) -> u32 {
+        let mut level = 0;
+        while level + 1 < self.levels && self.level_size(level) > face {
+            level += 1;
+        }
+        level
+    }
+
     /// Number of texels in all levels.
     #[inline]
     pub fn texel_count(&self) -> u32 {

@@ -384,12 +384,7 @@ pub fn exact_level(lobe: Lobe, roughness: f32, samples: u32, layout: CubeLayout)
     if !prefers_exact(lobe, roughness, samples, layout.size) {
         return SAMPLED;
     }
-    let t = exact_source_size(lobe, roughness, layout.size);
-    let mut level = 0;
-    while level + 1 < layout.levels && layout.level_size(level) > t {
-        level += 1;
-    }
-    level
+    layout.level_of_size(exact_source_size(lobe, roughness, layout.size))
 }
 
 /// Adds texels `start .. start + count` of source level `level` to the exact mean weighted

@@ -178,7 +178,7 @@ pub fn cube_source<K: Kernels>(k: &K, mut full: K::Texels, face: u32, job: &Job)
     } else {
         k.build_mips(&mut full, full_layout)?;
     }
-    let start = full_layout.level_offset(crate::settings::level_of_size(full_layout, size));
+    let start = full_layout.level_offset(full_layout.level_of_size(size));
     Ok((k.slice(&full, start, full_layout.texel_count() - start)?, job.source_layout()))
 }
 

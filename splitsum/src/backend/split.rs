@@ -40,7 +40,7 @@ impl<T> Split<T> {
         if exact_level == splitsum_shaders::prefilter::SAMPLED {
             return 0;
         }
-        level_of_size(self.layout, src_layout.level_size(exact_level))
+        self.layout.level_of_size(src_layout.level_size(exact_level))
     }
 
     /// Terms of the residual's sum for a level with `samples` samples, or summed exactly
@@ -48,12 +48,6 @@ impl<T> Split<T> {
     pub fn terms(&self, exact_level: u32, residual_level: u32, samples: u32) -> u32 {
         if exact_level == splitsum_shaders::prefilter::SAMPLED { samples } else { FACES * self.layout.level_size(residual_level).pow(2) }
     }
-}
-
-/// The level of `layout` whose faces are `face` wide (power-of-two sizes; the smallest
-/// level for a face smaller than that, the largest for one larger).
-fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
-    CubeLayout::full_chain(layout.size).saturating_sub(CubeLayout::full_chain(face)).min(layout.levels - 1)
 }
 
 /// Face size of the level `job` splits its source (faces of `src_size`) at, if any of
@@ -121,7 +115,7 @@ pub fn split_level(level: &[Vec4], size: u32) -> (Vec<Vec4>, Vec<Vec4>) {
 pub fn prefilter<K: Kernels>(k: &K, src: &K::Texels, src_layout: CubeLayout, job: &Prefilter<'_>) -> Result<K::Texels> {
     let split = match split_size(job, src_layout.size) {
         Some(t) => {
-            let level = level_of_size(src_layout, t);
+            let level = src_layout.level_of_size(t);
             let t = src_layout.level_size(level);
             let n = FACES * t * t;
             let texels = k.read(&k.slice(src, src_layout.level_offset(level), n)?)?;

@@ -192,12 +192,12 @@ impl Job {
 
     /// The source level the irradiance convolution sums over.
     pub fn irradiance_level(&self) -> u32 {
-        level_of_size(self.source_layout(), self.irradiance_source)
+        self.source_layout().level_of_size(self.irradiance_source)
     }
 
     /// The source level projected onto SH9.
     pub fn sh_level(&self) -> u32 {
-        level_of_size(self.source_layout(), self.sh_source)
+        self.source_layout().level_of_size(self.sh_source)
     }
 
     /// The BRDF table this job bakes, in words: `256² by quadrature (correlated)` or
@@ -236,11 +236,6 @@ impl Job {
 /// (`prefilter::exact_level`).
 pub fn exact_levels(lobe: Lobe, roughness: &[f32], samples: &[u32], exact: bool, src: CubeLayout) -> Vec<u32> {
     roughness.iter().zip(samples).map(|(&r, &n)| if exact { prefilter::exact_level(lobe, r, n, src) } else { prefilter::SAMPLED }).collect()
-}
-
-/// The source level whose faces are `face` wide (or the smallest there is).
-pub fn level_of_size(layout: CubeLayout, face: u32) -> u32 {
-    (0..layout.levels).find(|&l| layout.level_size(l) <= face).unwrap_or(layout.levels - 1)
 }
 
 /// One prefiltered cube of a job (the specular cube, the sheen cube): which roughness each

@@ -15,7 +15,7 @@ use splitsum_shaders::prefilter::RoughnessMapping;
 
 mod job;
 mod target;
-pub use job::{Job, exact_levels, level_of_size};
+pub use job::{Job, exact_levels};
 use job::JobValues;
 pub use target::{Fixed, Target};
 
