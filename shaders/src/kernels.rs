@@ -250,18 +250,28 @@ pub fn prefilter_bright(
     }
 }
 
-/// One texel of the sheen ring (sheen roughness 0) from a split source
-/// (`bright::ring_texel`): `buf` holds the residual's ring, a `src_size`² cube, then from
-/// index `start` the `count` entries of the excess list; written at `dst_offset` on.
+/// One texel of a split sheen level traced at the split level's size, the ring (sheen
+/// roughness 0) among them (`bright::traced_texel`): `buf` holds the residual's mean, a
+/// `src_size`² cube, then from index `start` the `count` entries of the excess list, or for
+/// the ring a header per tile (`bright::ring_tile`: the index of its first entry from
+/// `start`, and their count, as the bits of `x` and `y`) and the tiles' entries; written at `dst_offset` on.
 #[spirv(compute(threads(8, 8)))]
-pub fn prefilter_ring(
+pub fn prefilter_traced(
     #[spirv(global_invocation_id)] id: UVec3,
     #[spirv(uniform, descriptor_set = 0, binding = 0)] p: &PrefilterParams,
     #[spirv(storage_buffer, descriptor_set = 0, binding = 1)] buf: &[Vec4],
     #[spirv(storage_buffer, descriptor_set = 0, binding = 2)] out: &mut [Vec4],
 ) {
     if let Some((_, i, n)) = prefilter_invocation(id, p) {
-        out[i] = crate::bright::ring_texel(buf, p.src_size, p.start, p.count, n);
+        let alpha = Lobe::from_u32(p.lobe).alpha(p.roughness);
+        let ring = p.roughness <= 0.0;
+        let (list, count) = if ring {
+            let h = buf[(p.start + crate::bright::ring_tile(id.z, id.x, id.y, p.dst_size)) as usize];
+            (p.start + h.x.to_bits(), h.y.to_bits())
+        } else {
+            (p.start, p.count)
+        };
+        out[i] = crate::bright::traced_texel(buf, p.src_size, list, count, n, alpha, ring);
     }
 }
 

@@ -234,20 +234,6 @@ pub const KERNELS_PREFILTER_MIRROR: EntryPoint = EntryPoint {
 };
 static KERNELS_PREFILTER_MIRROR_MODULE: Module<[u8; include_bytes!("modules/kernels_prefilter_mirror.spv").len()]> = Module(*include_bytes!("modules/kernels_prefilter_mirror.spv"));
 
-/// `kernels_prefilter_ring`.
-pub const KERNELS_PREFILTER_RING: EntryPoint = EntryPoint {
-    name: "kernels_prefilter_ring",
-    stage: Stage::Compute,
-    workgroup_size: [8, 8, 1],
-    bindings: &[
-        Binding { group: 0, binding: 0, resource: Resource::Uniform },
-        Binding { group: 0, binding: 1, resource: Resource::Storage { read_only: true } },
-        Binding { group: 0, binding: 2, resource: Resource::Storage { read_only: false } },
-    ],
-    module: &KERNELS_PREFILTER_RING_MODULE,
-};
-static KERNELS_PREFILTER_RING_MODULE: Module<[u8; include_bytes!("modules/kernels_prefilter_ring.spv").len()]> = Module(*include_bytes!("modules/kernels_prefilter_ring.spv"));
-
 /// `kernels_prefilter_specular`.
 pub const KERNELS_PREFILTER_SPECULAR: EntryPoint = EntryPoint {
     name: "kernels_prefilter_specular",
@@ -261,6 +247,20 @@ pub const KERNELS_PREFILTER_SPECULAR: EntryPoint = EntryPoint {
     module: &KERNELS_PREFILTER_SPECULAR_MODULE,
 };
 static KERNELS_PREFILTER_SPECULAR_MODULE: Module<[u8; include_bytes!("modules/kernels_prefilter_specular.spv").len()]> = Module(*include_bytes!("modules/kernels_prefilter_specular.spv"));
+
+/// `kernels_prefilter_traced`.
+pub const KERNELS_PREFILTER_TRACED: EntryPoint = EntryPoint {
+    name: "kernels_prefilter_traced",
+    stage: Stage::Compute,
+    workgroup_size: [8, 8, 1],
+    bindings: &[
+        Binding { group: 0, binding: 0, resource: Resource::Uniform },
+        Binding { group: 0, binding: 1, resource: Resource::Storage { read_only: true } },
+        Binding { group: 0, binding: 2, resource: Resource::Storage { read_only: false } },
+    ],
+    module: &KERNELS_PREFILTER_TRACED_MODULE,
+};
+static KERNELS_PREFILTER_TRACED_MODULE: Module<[u8; include_bytes!("modules/kernels_prefilter_traced.spv").len()]> = Module(*include_bytes!("modules/kernels_prefilter_traced.spv"));
 
 /// `kernels_probe`.
 pub const KERNELS_PROBE: EntryPoint = EntryPoint {
@@ -334,7 +334,7 @@ pub const KERNELS_UNPACK_ROWS: EntryPoint = EntryPoint {
 static KERNELS_UNPACK_ROWS_MODULE: Module<[u8; include_bytes!("modules/kernels_unpack_rows.spv").len()]> = Module(*include_bytes!("modules/kernels_unpack_rows.spv"));
 
 /// Every compute entry point.
-pub const KERNELS: [EntryPoint; 19] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_CALIBRATE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9_PROJECT, KERNELS_PACK_HALF, KERNELS_PREFILTER_BRIGHT, KERNELS_PREFILTER_EXACT, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_RING, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];
+pub const KERNELS: [EntryPoint; 19] = [KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_CALIBRATE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9_PROJECT, KERNELS_PACK_HALF, KERNELS_PREFILTER_BRIGHT, KERNELS_PREFILTER_EXACT, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PREFILTER_TRACED, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];
 
 /// Every entry point.
-pub const ENTRY_POINTS: [EntryPoint; 23] = [DISPLAY_FULLSCREEN_VS, DISPLAY_MESH_FS, DISPLAY_MESH_VS, DISPLAY_SCENE_FS, KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_CALIBRATE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9_PROJECT, KERNELS_PACK_HALF, KERNELS_PREFILTER_BRIGHT, KERNELS_PREFILTER_EXACT, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_RING, KERNELS_PREFILTER_SPECULAR, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];
+pub const ENTRY_POINTS: [EntryPoint; 23] = [DISPLAY_FULLSCREEN_VS, DISPLAY_MESH_FS, DISPLAY_MESH_VS, DISPLAY_SCENE_FS, KERNELS_BRDF_LUT, KERNELS_BRDF_TABLE, KERNELS_CALIBRATE, KERNELS_DOWNSAMPLE, KERNELS_EQUIRECT_PYRAMID, KERNELS_EQUIRECT_TO_CUBE, KERNELS_IRRADIANCE_CUBE, KERNELS_IRRADIANCE_SH9_PROJECT, KERNELS_PACK_HALF, KERNELS_PREFILTER_BRIGHT, KERNELS_PREFILTER_EXACT, KERNELS_PREFILTER_MIRROR, KERNELS_PREFILTER_SPECULAR, KERNELS_PREFILTER_TRACED, KERNELS_PROBE, KERNELS_READ_CUBE, KERNELS_RESOLVE_LUT, KERNELS_RESOLVE_MEANS, KERNELS_UNPACK_ROWS];

@@ -232,25 +232,33 @@ pub fn work(p: Product, job: &Job) -> Work {
             for &l in &cube.levels {
                 let texels = faces(layout.level_size(l));
                 let m = l as usize;
-                if lobe.is_mirror(cube.roughness_per_mip[m]) {
+                let r = cube.roughness_per_mip[m];
+                // A level traced at the split level's size computes the residual's mean
+                // there, then reads it (4 texels) at each of its own texels.
+                let traced = split.and_then(|t| crate::backend::split::traced_size(lobe, r, layout.level_size(l), source.size, t));
+                let at = traced.map_or(texels, faces);
+                if lobe.is_mirror(r) {
                     w.filtered_reads += texels;
-                } else if let Some(rs) = split.filter(|_| crate::backend::split::is_ring(lobe, cube.roughness_per_mip[m])) {
-                    // The ring: sampled at the split level's size, then read (4 texels) with
-                    // the excess's chords (an entry read, a dot product and a comparison each,
-                    // most of them).
-                    let samples = faces(rs) * job.samples_per_mip[m] as f64;
-                    let chords = texels * crate::backend::split::TEXELS as f64;
-                    w.filtered_reads += 8.0 * samples + 4.0 * texels;
-                    w.summed_reads += chords;
-                    w.flops += p.flops_per_sample() * samples + 10.0 * chords;
                 } else if cube.exact_levels[m] != splitsum_shaders::prefilter::SAMPLED {
-                    let terms = texels * faces(source.level_size(cube.exact_levels[m]));
+                    let terms = at * faces(source.level_size(cube.exact_levels[m]));
                     w.summed_reads += terms;
                     w.flops += 90.0 * terms;
                 } else {
-                    let samples = texels * job.samples_per_mip[m] as f64;
+                    let samples = at * job.samples_per_mip[m] as f64;
                     w.filtered_reads += 8.0 * samples;
                     w.flops += p.flops_per_sample() * samples;
+                }
+                if traced.is_some() {
+                    w.filtered_reads += 4.0 * texels;
+                }
+                if traced.is_some() && r <= 0.0 {
+                    // The ring's chords: each texel reads its tile's header, and the few
+                    // tiles a sun's great circle crosses its entries (`split::ring_table`),
+                    // which depend on the sky and are not counted; the table itself is built
+                    // on the host, a test per tile and entry.
+                    let tiles = 6.0 * (splitsum_shaders::bright::ring_tiles(layout.level_size(l)) as f64).powi(2);
+                    w.summed_reads += texels;
+                    w.flops += 60.0 * tiles * crate::backend::split::TEXELS as f64;
                 }
                 if splitsum_shaders::bright::splits(lobe, cube.roughness_per_mip[m], source.size) {
                     // The excess list: at most `split::TEXELS` terms a texel, two texels each.

@@ -133,36 +133,49 @@ impl Kernels for Cpu {
             let start = out.level_offset(m) as usize;
             let level = &mut texels[start..start + (FACES * s * s) as usize];
             let (r, n, e) = (job.roughness[m as usize], job.samples[m as usize], job.exact[m as usize]);
-            if let Some(split) = split.filter(|_| super::split::is_ring(job.lobe, r)) {
-                // The residual's ring at the split level's size, then each texel read from
-                // it with the excess's chords.
-                let rs = split.layout.size;
-                let table: Vec<Vec4> = prefilter::lobe_samples(job.lobe, n, r, rs, job.lod_bias).collect();
-                let mut buf = vec![Vec4::ZERO; (FACES * rs * rs) as usize];
-                fill_level(&mut buf, rs, &Bar::hidden(), |face, x, y| {
-                    prefilter::prefilter_dir_samples(job.lobe, &split.residual, split.layout, cubemap::texel_dir(face, x, y, rs), &table)
-                });
-                buf.extend_from_slice(&split.list);
-                fill_level(level, s, &bar, |face, x, y| bright::ring_texel(&buf, rs, FACES * rs * rs, split.entries, cubemap::texel_dir(face, x, y, s)));
-            } else if let Some(split) = split.filter(|_| bright::splits(job.lobe, r, src_layout.size)) {
+            if let Some(split) = split.filter(|_| super::split::uses_split(job.lobe, r, src_layout.size)) {
                 // The residual sampled (its samples made once for the level) or summed over
-                // its level of the exact sum's size, then the excess.
+                // its level of the exact sum's size, then the excess: at each texel, or the
+                // residual traced at the split level's size and read from it with the
+                // excess's terms (the ring's chords, or the density).
                 let table: Vec<Vec4> =
                     if e == prefilter::SAMPLED { prefilter::lobe_samples(job.lobe, n, r, split.layout.size, job.lod_bias).collect() } else { Vec::new() };
                 let residual_level = split.level_of(src_layout, e);
                 let terms = split.terms(e, residual_level, n);
                 let alpha = job.lobe.alpha(r);
-                fill_level(level, s, &bar, |face, x, y| {
-                    let d = cubemap::texel_dir(face, x, y, s);
-                    let p = MeanPartial::default().then_chunked(terms, |start, c, p| {
+                let residual = |d| {
+                    MeanPartial::default().then_chunked(terms, |start, c, p| {
                         if e == prefilter::SAMPLED {
                             prefilter::accumulate_samples(job.lobe, &split.residual, split.layout, d, &table, start, c, p)
                         } else {
                             prefilter::exact_accumulate(job.lobe, &split.residual, split.layout, residual_level, d, r, start, c, p)
                         }
+                    })
+                };
+                if let Some(ts) = split.traced(job.lobe, r, s, src_layout.size) {
+                    let mut buf = vec![Vec4::ZERO; (FACES * ts * ts) as usize];
+                    fill_level(&mut buf, ts, &Bar::hidden(), |face, x, y| residual(cubemap::texel_dir(face, x, y, ts)).resolve());
+                    // The ring reads its tile's entries (`split::ring_table`), any other
+                    // level the whole list.
+                    let ring = r <= 0.0;
+                    let tail = if ring { split.ring.as_ref().expect("a job with a ring has its table") } else { &split.list };
+                    let start = FACES * ts * ts;
+                    buf.extend_from_slice(tail);
+                    fill_level(level, s, &bar, |face, x, y| {
+                        let (list, count) = if ring {
+                            let h = buf[(start + bright::ring_tile(face, x, y, s)) as usize];
+                            (start + h.x.to_bits(), h.y.to_bits())
+                        } else {
+                            (start, split.entries)
+                        };
+                        bright::traced_texel(&buf, ts, list, count, cubemap::texel_dir(face, x, y, s), alpha, ring)
                     });
-                    p.then_chunked(split.entries, |start, c, p| bright::accumulate(&split.list, d, alpha, start, c, p)).resolve()
-                });
+                } else {
+                    fill_level(level, s, &bar, |face, x, y| {
+                        let d = cubemap::texel_dir(face, x, y, s);
+                        residual(d).then_chunked(split.entries, |start, c, p| bright::accumulate(&split.list, d, alpha, start, c, p)).resolve()
+                    });
+                }
             } else if e == prefilter::SAMPLED && !job.lobe.is_mirror(r) && job.lobe.alpha(r) > 0.0 {
                 // The samples depend on no texel: made once for the level.
                 let table: Vec<Vec4> = prefilter::lobe_samples(job.lobe, n, r, src_layout.size, job.lod_bias).collect();

@@ -31,6 +31,9 @@ pub struct Split<T> {
     pub list: T,
     /// Entries in the list.
     pub entries: u32,
+    /// The list binned by the tiles of the ring's output ([`ring_table`]), where the job
+    /// has a ring.
+    pub ring: Option<T>,
 }
 
 impl<T> Split<T> {
@@ -41,6 +44,12 @@ impl<T> Split<T> {
             return 0;
         }
         self.layout.level_of_size(src_layout.level_size(exact_level))
+    }
+
+    /// The face size a level of faces `size` of `lobe` for `roughness` is traced at
+    /// (see [`traced_size`]), on a source of faces `src_size`.
+    pub fn traced(&self, lobe: Lobe, roughness: f32, size: u32, src_size: u32) -> Option<u32> {
+        traced_size(lobe, roughness, size, src_size, self.layout.size)
     }
 
     /// Terms of the residual's sum for a level with `samples` samples, or summed exactly
@@ -58,22 +67,40 @@ pub fn split_size(job: &Prefilter<'_>, src_size: u32) -> Option<u32> {
 
 /// Face size of the level a cube of `lobe` whose mip `m` holds `roughness[m]`, baking
 /// `levels`, splits a source of faces `src_size` at, if any level splits
-/// (`bright::splits`): one coarser than the exact sum's level for the sharpest of them (a
-/// texel a quarter of its ring's width; see [`TEXELS`]). The ring (roughness 0) is then
-/// traced at this size too (`bright::ring_texel`).
+/// (`bright::splits`): the [`band_size`] of the sharpest of them (see [`TEXELS`]). The
+/// ring (roughness 0) is traced at this size ([`traced_size`]).
 pub fn split_size_of(lobe: Lobe, roughness: &[f32], levels: &[u32], src_size: u32) -> Option<u32> {
-    levels
-        .iter()
-        .map(|&m| roughness[m as usize])
-        .filter(|&r| bright::splits(lobe, r, src_size))
-        .map(|r| splitsum_shaders::prefilter::exact_source_size(lobe, r, src_size))
-        .max()
-        .map(|t| (t / 2).max(1))
+    levels.iter().map(|&m| roughness[m as usize]).filter(|&r| bright::splits(lobe, r, src_size)).map(|r| band_size(lobe, r, src_size)).max()
 }
 
-/// Whether a level of `lobe` for `roughness` is the sheen ring, which a split source traces
-/// at the split level's size (`bright::ring_texel`).
-pub fn is_ring(lobe: Lobe, roughness: f32) -> bool {
+/// The coarsest face size that resolves the band of `lobe` for `roughness` on a source of
+/// faces `src_size`: one level coarser than its exact sum's
+/// (`prefilter::exact_source_size`), a texel a quarter of the band's width.
+pub fn band_size(lobe: Lobe, roughness: f32, src_size: u32) -> u32 {
+    (splitsum_shaders::prefilter::exact_source_size(lobe, roughness, src_size) / 2).max(1)
+}
+
+/// The face size a level of faces `size` of `lobe` for `roughness` is traced at, when its
+/// source (faces `src_size`) splits at faces `split_size`: the ring (sheen roughness 0) at
+/// the split level's; a split level at its [`band_size`] where that is coarser than the
+/// level, the residual's mean then read bilinearly and the excess summed at every texel
+/// (`bright::traced_texel`); `None` for a level computed at its own size.
+pub fn traced_size(lobe: Lobe, roughness: f32, size: u32, src_size: u32, split_size: u32) -> Option<u32> {
+    if is_ring(lobe, roughness) {
+        return Some(split_size);
+    }
+    let band = band_size(lobe, roughness, src_size).min(split_size);
+    (bright::splits(lobe, roughness, src_size) && size > band).then_some(band)
+}
+
+/// Whether a level of `lobe` for `roughness` is filtered from a split source (faces of
+/// `src_size`): a level that splits (`bright::splits`), or the ring.
+pub fn uses_split(lobe: Lobe, roughness: f32, src_size: u32) -> bool {
+    is_ring(lobe, roughness) || bright::splits(lobe, roughness, src_size)
+}
+
+/// Whether a level of `lobe` for `roughness` is the sheen ring (sheen roughness 0).
+fn is_ring(lobe: Lobe, roughness: f32) -> bool {
     lobe == Lobe::Charlie && roughness <= 0.0
 }
 
@@ -109,6 +136,35 @@ pub fn split_level(level: &[Vec4], size: u32) -> (Vec<Vec4>, Vec<Vec4>) {
     (residual, list)
 }
 
+/// The excess list `list` (`entries` entries) binned by the tiles of a `size`-wide ring
+/// output (`bright::ring_tile`): a header per tile, the index of its first entry from the
+/// table's start and their count as the bits of `x` and `y`, then each tile's entries, those
+/// whose chords reach it (`bright::ring_tile_reached`), in the list's order. A sun's chords
+/// reach the tiles along one great circle; each texel of the ring reads only its tile's.
+pub fn ring_table(list: &[Vec4], entries: u32, size: u32) -> Vec<Vec4> {
+    use rayon::prelude::*;
+    let t = bright::ring_tiles(size);
+    let tiles = FACES * t * t;
+    let reached: Vec<Vec<u32>> = (0..tiles)
+        .into_par_iter()
+        .map(|i| {
+            let (face, ty, tx) = (i / (t * t), i / t % t, i % t);
+            (0..entries).filter(|&j| bright::ring_tile_reached(face, tx, ty, size, list[(bright::ENTRY * j) as usize])).collect()
+        })
+        .collect();
+    let mut table = Vec::with_capacity(tiles as usize + reached.iter().map(|r| r.len() * bright::ENTRY as usize).sum::<usize>());
+    let mut first = tiles;
+    for r in &reached {
+        table.push(Vec4::new(f32::from_bits(first), f32::from_bits(r.len() as u32), 0.0, 0.0));
+        first += bright::ENTRY * r.len() as u32;
+    }
+    for j in reached.iter().flatten() {
+        let at = (bright::ENTRY * j) as usize;
+        table.extend_from_slice(&list[at..at + bright::ENTRY as usize]);
+    }
+    table
+}
+
 /// The prefiltered cube of `job` from `src` on `k`: the source split first where a level
 /// of `job` splits ([`split_size`]; its level read back, split, and the residual's mips
 /// built on `k`).
@@ -125,9 +181,13 @@ pub fn prefilter<K: Kernels>(k: &K, src: &K::Texels, src_layout: CubeLayout, job
             let mut residual = k.upload("sheen residual", &residual)?;
             k.build_mips(&mut residual, layout)?;
             let entries = list.len() as u32 / bright::ENTRY;
+            let ring = match job.levels.iter().find(|&&m| is_ring(job.lobe, job.roughness[m as usize])) {
+                Some(&m) => Some(k.upload("sheen ring excess", &ring_table(&list, entries, job.layout.level_size(m)))?),
+                None => None,
+            };
             // A buffer is never empty: an unused entry stands in for none.
             let list = if list.is_empty() { vec![Vec4::ZERO; bright::ENTRY as usize] } else { list };
-            Some(Split { residual, layout, list: k.upload("sheen excess", &list)?, entries })
+            Some(Split { residual, layout, list: k.upload("sheen excess", &list)?, entries, ring })
         }
         None => None,
     };

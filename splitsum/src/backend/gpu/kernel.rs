@@ -67,7 +67,7 @@ kernels! {
     /// The excess list of a split source added to a prefiltered cube's sums.
     PREFILTER_BRIGHT = KERNELS_PREFILTER_BRIGHT(PrefilterParams);
     /// The sheen ring of a split source, read from the residual's ring and the excess.
-    PREFILTER_RING = KERNELS_PREFILTER_RING(PrefilterParams);
+    PREFILTER_TRACED = KERNELS_PREFILTER_TRACED(PrefilterParams);
     /// Means from chunks' partial sums.
     RESOLVE_MEANS = KERNELS_RESOLVE_MEANS(ResolveParams);
     /// A chunk of the irradiance convolution.

@@ -17,7 +17,7 @@ use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
 use splitsum_shaders::calibrate::Rate;
 use splitsum_shaders::kernels::{CalibrateParams, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, ResolveParams, TableParams};
-use splitsum_shaders::{bright, equirect, lut, prefilter};
+use splitsum_shaders::{equirect, lut, prefilter};
 
 /// Texels on the device: `count` RGBA f32 texels in `buffer`.
 pub struct Texels {
@@ -193,33 +193,36 @@ impl Kernels for Gpu {
                 self.run(&[kernel::PREFILTER_MIRROR.dispatch(&p, Some(&src.buffer), &result.buffer, [s, s, FACES])]);
                 continue;
             }
-            if let Some(split) = split.filter(|_| crate::backend::split::is_ring(job.lobe, r)) {
-                // The residual's ring at the split level's size into a buffer that holds the
-                // excess list after it, then each texel read from it with the list's chords.
-                let rs = split.layout.size;
-                let ring = FACES * rs * rs;
-                let buf = self.output("sheen ring", bytes((ring + split.list.count) as u64))?;
-                let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-                encoder.copy_buffer_to_buffer(&split.list.buffer, 0, &buf, bytes(ring as u64), bytes(split.list.count as u64));
-                self.queue.submit([encoder.finish()]);
-                let sums = self.output("sheen ring sums", 3 * bytes(ring as u64))?;
-                let q = PrefilterParams { src_size: rs, src_levels: split.layout.levels, dst_size: rs, dst_offset: 0, ..p };
-                for (start, count) in chunks(samples) {
-                    let q = PrefilterParams { start, count, ..q };
-                    self.run(&[kernel::PREFILTER_SAMPLED.dispatch(&q, Some(&split.residual.buffer), &sums, [rs, rs, FACES])]);
-                }
-                self.resolve(&sums, &buf, 0, ring);
-                let q = PrefilterParams { src_size: rs, start: ring, count: split.entries, ..p };
-                self.run(&[kernel::PREFILTER_RING.dispatch(&q, Some(&buf), &result.buffer, [s, s, FACES])]);
-                continue;
-            }
-            if let Some(split) = split.filter(|_| bright::splits(job.lobe, r, src_layout.size)) {
-                // The residual's samples or exact sum, then the excess list, on the same sums.
+            if let Some(split) = split.filter(|_| crate::backend::split::uses_split(job.lobe, r, src_layout.size)) {
+                // The residual's samples or exact sum, then the excess list: on the level's
+                // own sums, or traced at the split level's size into a buffer that holds the
+                // list after it, each texel then read from it with the list's terms.
                 let residual_level = split.level_of(src_layout, exact_level);
                 let exact_level = if exact_level == prefilter::SAMPLED { exact_level } else { residual_level };
                 let q = PrefilterParams { src_size: split.layout.size, src_levels: split.layout.levels, exact_level, ..p };
                 let kernel = if exact_level == prefilter::SAMPLED { &kernel::PREFILTER_SAMPLED } else { &kernel::PREFILTER_EXACT };
-                for (start, count) in chunks(split.terms(exact_level, residual_level, samples)) {
+                let terms = split.terms(exact_level, residual_level, samples);
+                if let Some(ts) = split.traced(job.lobe, r, s, src_layout.size) {
+                    // The ring reads its tile's entries (`split::ring_table`), any other
+                    // level the whole list.
+                    let tail = if r <= 0.0 { split.ring.as_ref().expect("a job with a ring has its table") } else { &split.list };
+                    let traced = FACES * ts * ts;
+                    let buf = self.output("sheen traced level", bytes((traced + tail.count) as u64))?;
+                    let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+                    encoder.copy_buffer_to_buffer(&tail.buffer, 0, &buf, bytes(traced as u64), bytes(tail.count as u64));
+                    self.queue.submit([encoder.finish()]);
+                    let sums = self.output("sheen traced sums", 3 * bytes(traced as u64))?;
+                    let q = PrefilterParams { dst_size: ts, dst_offset: 0, ..q };
+                    for (start, count) in chunks(terms) {
+                        let q = PrefilterParams { start, count, ..q };
+                        self.run(&[kernel.dispatch(&q, Some(&split.residual.buffer), &sums, [ts, ts, FACES])]);
+                    }
+                    self.resolve(&sums, &buf, 0, traced);
+                    let q = PrefilterParams { src_size: ts, start: traced, count: split.entries, ..p };
+                    self.run(&[kernel::PREFILTER_TRACED.dispatch(&q, Some(&buf), &result.buffer, [s, s, FACES])]);
+                    continue;
+                }
+                for (start, count) in chunks(terms) {
                     let q = PrefilterParams { start, count, ..q };
                     self.run(&[kernel.dispatch(&q, Some(&split.residual.buffer), &accum, [s, s, FACES])]);
                 }
