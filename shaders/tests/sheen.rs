@@ -173,3 +173,70 @@ fn charlie_light_samples_invert_their_distribution() {
         assert!((mean - want).abs() <= 1e-3 * want, "r {r}: mean n·l {mean} against {want}");
     }
 }
+
+/// The ring's tiles (`bright::ring_tile_reached`, `splitsum::backend::split::ring_table`)
+/// lose no chord: for entries of every solid angle a 16²–256² split level holds, in
+/// directions spread over the sphere and on face edges and corners, every tile holding a
+/// texel centre whose `(n·l)² < Ω/π` (the chord's support, in f64 from the reference's own
+/// face mapping) is reached. And the tiles pay: a 256² ring's tiles reach under a tenth of
+/// the entries of a 64² split level on average.
+#[test]
+fn ring_tiles_keep_every_chord() {
+    use splitsum_shaders::bright::{ring_tile, ring_tile_reached, ring_tiles};
+    use splitsum_shaders::glam::Vec4;
+    let mut dirs: Vec<[f64; 3]> = (0..96)
+        .map(|i| {
+            let p = hammersley(i, 96);
+            let (z, phi) = (1.0 - 2.0 * p.x as f64, 2.0 * PI * p.y as f64);
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            [r * phi.cos(), r * phi.sin(), z]
+        })
+        .collect();
+    // Face edges and corners.
+    let s = 1.0 / 2f64.sqrt();
+    let t = 1.0 / 3f64.sqrt();
+    dirs.extend([[s, s, 0.0], [0.0, -s, s], [-s, 0.0, -s], [t, t, t], [-t, t, -t], [t, -t, -t]]);
+    for size in [8u32, 64, 256] {
+        let tiles = ring_tiles(size);
+        let mut reached = 0u64;
+        let mut tested = 0u64;
+        for split in [16u32, 64, 256] {
+            // A texel's solid angle at the face centre of a `split`² level, and ten times it.
+            for omega in [4.0 / (split * split) as f64, 40.0 / (split * split) as f64] {
+                for d in &dirs {
+                    let g = Vec4::new(d[0] as f32, d[1] as f32, d[2] as f32, omega as f32);
+                    let mut must = vec![false; (6 * tiles * tiles) as usize];
+                    for face in 0..6 {
+                        for y in 0..size {
+                            for x in 0..size {
+                                let n = splitsum_reference::texel_dir(face, x, y, size);
+                                let u = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+                                if u * u < omega / PI {
+                                    must[ring_tile(face, x, y, size) as usize] = true;
+                                }
+                            }
+                        }
+                    }
+                    for face in 0..6 {
+                        for ty in 0..tiles {
+                            for tx in 0..tiles {
+                                let got = ring_tile_reached(face, tx, ty, size, g);
+                                let want = must[((face * tiles + ty) * tiles + tx) as usize];
+                                assert!(got || !want, "{size}²: tile ({face}, {tx}, {ty}) misses an entry along {d:?} of Ω {omega:e}");
+                                if split == 64 && size == 256 {
+                                    reached += got as u64;
+                                    tested += 1;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        if size == 256 {
+            let share = reached as f64 / tested as f64;
+            println!("256² ring, 64² split level: a tile reaches {:.1} % of the entries", 100.0 * share);
+            assert!(share < 0.1, "{share}");
+        }
+    }
+}
