@@ -382,13 +382,28 @@ fn a_gltf_model_with_sheen_loads_and_renders() {
 /// source cube's resampling stay below 0.1 % at this sun's width.
 #[test]
 fn the_default_sheen_cube_on_a_sunny_sky() {
+    // Measured: 0.07–0.48 % at every mip (the source split, `bright`, its entries at the
+    // excess's centroids; before the centroids 0.13–1.89 %, the ring the worst).
+    sunny_sheen(5e4, true);
+}
+
+/// The same sky with a sun of 10⁶, the top of the range the project holds: the same
+/// bounds. Measured 0.18–0.87 % (0.48–4.51 % with each excess texel at its centre).
+#[test]
+fn the_default_sheen_cube_under_a_sun_of_a_million() {
+    sunny_sheen(1e6, false);
+}
+
+/// [`the_default_sheen_cube_on_a_sunny_sky`] with a sun `amplitude` bright, asserting its
+/// bounds; writes the guide's figure where `figure`.
+fn sunny_sheen(amplitude: f64, figure: bool) {
     let e = 8f64.to_radians();
     let sun = reference::normalize([0.6 * e.cos(), e.sin(), -0.8 * e.cos()]);
     let sky = move |d: [f64; 3]| {
         let t = 0.5 + 0.5 * d[1];
         let c = reference::dot(d, sun).clamp(-1.0, 1.0);
         // 1 − cos θ ≈ θ²/2: exp(−θ²/(2σ²)).
-        let g = 5e4 * (-(1.0 - c) / (0.02f64 * 0.02)).exp();
+        let g = amplitude * (-(1.0 - c) / (0.02f64 * 0.02)).exp();
         [0.3 + 0.4 * t + g, 0.4 + 0.5 * t + g, 0.6 + 0.8 * t + g]
     };
     let (w, h) = (1024u32, 512u32);
@@ -415,7 +430,7 @@ fn the_default_sheen_cube_on_a_sunny_sky() {
         (state >> 8) % m
     };
     let seconds = t.elapsed().as_secs_f64();
-    let mut figure = support::figure::Figure::new(
+    let mut table = support::figure::Figure::new(
         "sheen-sunny",
         "cargo test --release -p splitsum-tests --test suite sheen::the_default_sheen_cube_on_a_sunny_sky",
         &["mip", "sheen roughness", "mean relative error", "worst texel"],
@@ -435,23 +450,22 @@ fn the_default_sheen_cube_on_a_sunny_sky() {
             .collect();
         let mean = errors.iter().sum::<f64>() / errors.len() as f64;
         let worst = errors.iter().copied().fold(0.0, f64::max);
-        println!("sheen mip {m} (sheen roughness {r:.2}): mean relative error {:.2} %, worst {:.1} %", 100.0 * mean, 100.0 * worst);
-        figure.row(vec![format!("{m}"), format!("{r:.2}"), format!("{:.2} %", 100.0 * mean), format!("{:.0} %", 100.0 * worst)]);
+        println!("sun {amplitude:e}, sheen mip {m} (sheen roughness {r:.2}): mean relative error {:.2} %, worst {:.1} %", 100.0 * mean, 100.0 * worst);
+        table.row(vec![format!("{m}"), format!("{r:.2}"), format!("{:.2} %", 100.0 * mean), format!("{:.0} %", 100.0 * worst)]);
         errs.push(mean);
     }
-    figure.note(format!(
-        "The default sheen cube ({}², {} mips, CPU backend, {seconds:.2} s for the whole bake) of a held-out sky with a sun of 5·10⁴ (Gaussian, σ = 0.02 rad, 8° up), 1024×512, against the product quadrature of the analytic sky in the lobe's own coordinates (`reference::sheen::prefilter_of`), 160 texels a mip.",
-        sheen.layout.size,
-        sheen.layout.levels
-    ));
-    figure.write();
+    if figure {
+        table.note(format!(
+            "The default sheen cube ({}², {} mips, CPU backend, {seconds:.2} s for the whole bake) of a held-out sky with a sun of 5·10⁴ (Gaussian, σ = 0.02 rad, 8° up), 1024×512, against the product quadrature of the analytic sky in the lobe's own coordinates (`reference::sheen::prefilter_of`), 160 texels a mip.",
+            sheen.layout.size,
+            sheen.layout.levels
+        ));
+        table.write();
+    }
     // The targets: within 3 % at every mip, within 1 % at sheen roughness ≥ 0.7.
-    // Measured: 1.89 % at the ring (mip 0: the residual's ring traced at 64², the excess by
-    // its chords; 2.89 % with 64 samples of the ring at 256²), 0.13–0.46 % at mips 1–5 (the
-    // source split: `bright`).
     for (m, (&e, &r)) in errs.iter().zip(roughness.iter()).enumerate() {
         let bound = if r >= 0.7 { 0.01 } else { 0.03 };
-        assert!(e <= bound, "sheen mip {m} (roughness {r:.2}): {:.2} % against {:.0} %", 100.0 * e, 100.0 * bound);
+        assert!(e <= bound, "sun {amplitude:e}, sheen mip {m} (roughness {r:.2}): {:.2} % against {:.0} %", 100.0 * e, 100.0 * bound);
     }
 }
 
