@@ -6,9 +6,16 @@
 # splitsum's shading of the same pixels at 1, 4 and 16 fetches. Prints the table the README
 # quotes. 22 s on 2 cores for all eight environments at 256 samples, 64² (once Mitsuba is
 # installed and the example built).
-#   bash scripts/mitsuba.sh [SPP] [RES] [ENVIRONMENT...]
+# With --figure FILE it also writes the table as a generated figure of the guide (`bash
+# scripts/dev.sh figures` writes book/src/figures/mitsuba.md so).
+#   bash scripts/mitsuba.sh [--figure FILE] [SPP] [RES] [ENVIRONMENT...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+FIGURE=()
+if [ "${1:-}" = "--figure" ]; then
+    FIGURE=("$2")
+    shift 2
+fi
 # SPLITSUM_DRY_RUN: print the commands instead of running them (as scripts/dev.sh does).
 dry() { [ -n "${SPLITSUM_DRY_RUN:-}" ]; }
 run() { if dry; then printf 'dry-run:'; printf ' %q' "$@"; echo; return 0; fi; "$@"; }
@@ -26,4 +33,4 @@ export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}
 run bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- envs "$OUT" "${@:3}"
 run "$VENV/bin/python" scripts/mitsuba_spheres.py render "$OUT" "$SPP" "$RES" >&2
 run bash scripts/dev.sh cargo run --release -q -p splitsum-report --example mitsuba_spheres -- shade "$OUT"
-run "$VENV/bin/python" scripts/mitsuba_spheres.py compare "$OUT"
+run "$VENV/bin/python" scripts/mitsuba_spheres.py compare "$OUT" "$SPP" "$RES" ${FIGURE[@]+"${FIGURE[@]}"}

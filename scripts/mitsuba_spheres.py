@@ -4,7 +4,7 @@ with material 'none', GGX, visible-normal sampling) under each sunny environment
 pixels (`mitsuba_spheres shade DIR`). Run by scripts/mitsuba.sh.
 
   python3 mitsuba_spheres.py render DIR SPP RES
-  python3 mitsuba_spheres.py compare DIR
+  python3 mitsuba_spheres.py compare DIR SPP RES [FIGURE]
 """
 import math
 import struct
@@ -106,11 +106,35 @@ def luminance(rgb):
     return rgb @ np.array([0.2126, 0.7152, 0.0722])
 
 
-def compare(directory):
+def machine():
+    """This machine in the words the report's figures use: cores and CPU model."""
+    import os
+    model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines() if line.startswith("model name")), "unknown CPU")
+    return f"{os.cpu_count()} cores of {' '.join(model.split()[:2])}"
+
+
+def commit():
+    """The commit measured, and whether the work tree differed from it."""
+    import subprocess
+    head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip() or "unknown"
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True).stdout.strip()
+    return head + (" with uncommitted changes" if dirty else "")
+
+
+def compare(directory, spp, res, figure=None):
+    """Prints the per-sphere table and the means over each set; with `figure`, writes them
+    there too, as a generated figure of the guide (its command, date, machine and commit)."""
+    import datetime
     directory = Path(directory)
+    lines = []
+
+    def say(text=""):
+        lines.append(text)
+        print(text)
+
     rows = []
-    print("| environment | set | r | Mitsuba's noise per pixel | " + " | ".join(f"{k} fetch{'es' if k > 1 else ''}: mean per pixel (sphere's mean)" for k in FETCHES) + " | n.v 0.15-0.7, 1 fetch (signed) |")
-    print("|---|---|---|---|" + "---|" * (len(FETCHES) + 1))
+    say("| environment | set | r | Mitsuba's noise per pixel | " + " | ".join(f"{k} fetch{'es' if k > 1 else ''}: mean per pixel (sphere's mean)" for k in FETCHES) + " | n·v 0.15–0.7, 1 fetch (signed) |")
+    say("|---|---|---|---|" + "---|" * (len(FETCHES) + 1))
     for line in (directory / "envs.txt").read_text().splitlines():
         slug, which, name = line.split("\t")
         points = np.fromfile(directory / f"{slug}_points.f32", dtype="<f4").reshape(-1, 6)
@@ -131,16 +155,24 @@ def compare(directory):
                 if k == 1:
                     band = nv <= 0.7
                     signed = (got[band] - truth[band]).mean() / truth[band].mean()
-            print(f"| {name} | {which} | {r} | " + " | ".join(cells) + f" | {100 * signed:+.1f} % |")
-    print()
+            say(f"| {name} | {which} | {r} | " + " | ".join(cells) + f" | {100 * signed:+.1f} % |")
+    say()
     for which in ["tuning", "held-out"]:
         for k in FETCHES:
             sel = [row for row in rows if row[0] == which and row[2] == k]
-            print(f"{which}, {k} fetch(es): mean over spheres of the mean per-pixel error {100 * np.mean([s[3] for s in sel]):.1f} % (Mitsuba's noise {100 * np.mean([s[5] for s in sel]):.1f} %), worst sphere {100 * max(s[3] for s in sel):.1f} %; error of the sphere's mean {100 * np.mean([s[4] for s in sel]):.1f} %")
+            say(f"- {which}, {k} fetch(es): mean over spheres of the mean per-pixel error {100 * np.mean([s[3] for s in sel]):.1f} % (Mitsuba's noise {100 * np.mean([s[5] for s in sel]):.1f} %), worst sphere {100 * max(s[3] for s in sel):.1f} %; error of the sphere's mean {100 * np.mean([s[4] for s in sel]):.1f} %")
+    if figure:
+        head = f"<!-- Written by `bash scripts/mitsuba.sh --figure {figure} {spp} {res}` (scripts/mitsuba_spheres.py); regenerate it, do not edit it. -->\n\n"
+        tail = (
+            f"\nWhite-metal spheres (F₀ = 1, GGX, α = r²) rendered by Mitsuba 3's path tracer at {spp} samples per pixel, {res}×{res}, "
+            "against splitsum's shading of the same pixels (defaults, n·v ≥ 0.15): mean relative luminance error per pixel, the error of the sphere's mean luminance in brackets. "
+            f"Measured {datetime.date.today().isoformat()}, {machine()}, commit {commit()}.\n"
+        )
+        Path(figure).write_text(head + "\n".join(lines) + "\n" + tail)
 
 
 if __name__ == "__main__":
     if sys.argv[1] == "render":
         render(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]))
     else:
-        compare(sys.argv[2])
+        compare(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), sys.argv[5] if len(sys.argv) > 5 else None)
