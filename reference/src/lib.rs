@@ -147,6 +147,7 @@ pub fn texels(level: &[splitsum_shaders::glam::Vec4], s: u32) -> Vec<([f64; 3], 
 /// `L̃(n) = Σ L D(h) max(0, n·l) Ω / Σ D(h) max(0, n·l) Ω`, `h = (n + l)/|n + l|`.
 /// GGX `D` in its textbook form `α² / (π ((n·h)²(α² − 1) + 1)²)`.
 pub fn prefilter(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3], roughness: f64) -> [f64; 3] {
+    let n = normalize(n); // see Environment::prefilter
     let a2 = (roughness * roughness).powi(2);
     let mut acc = [0.0; 3];
     let mut wsum = 0.0;
@@ -226,6 +227,7 @@ pub fn schlick_weight_hemispherical_mean(n_dot_v: f64, tol: f64) -> f64 {
 /// glTF BRDF ([`gltf_brdf_cos`]), GGX `D` (α = r²) in its textbook form and Smith–Schlick
 /// `G` with `k = α/2` (the remapping the split sum's sampled table uses).
 pub fn shade_full(texels: &[([f64; 3], f64, [f64; 3])], n: [f64; 3], v: [f64; 3], base: [f64; 3], metallic: f64, roughness: f64) -> [f64; 3] {
+    let (n, v) = (normalize(n), normalize(v)); // see Environment::prefilter
     let a2 = (roughness * roughness).powi(2);
     let k = roughness * roughness / 2.0;
     let nv = dot(n, v);
@@ -368,7 +370,13 @@ impl Environment {
 
     /// GGX-prefiltered radiance with `n = v = r` (see [`prefilter`]), sub-sampled where the
     /// lobe is narrower than a texel.
+    ///
+    /// `n` is normalised here, in f64: a direction normalised in f32 is off unit length by
+    /// up to 6·10⁻⁸, which moves `(n·h)²(α² − 1) + 1` by as much as `α²` itself at r 0.02
+    /// (`α² = 1.6·10⁻⁷`) and puts the peak of `D` beside where it is: half a texel from a
+    /// texel 10⁴ times its sky, 9.7 % off (`reference_directions_need_not_be_unit_length`).
     pub fn prefilter(&self, n: [f64; 3], roughness: f64) -> [f64; 3] {
+        let n = normalize(n);
         let alpha = roughness * roughness;
         let a2 = alpha * alpha;
         let half = |l: [f64; 3]| normalize([n[0] + l[0], n[1] + l[1], n[2] + l[2]]);
@@ -392,6 +400,8 @@ impl Environment {
     /// texel.
     #[allow(clippy::too_many_arguments)]
     pub fn shade(&self, n: [f64; 3], v: [f64; 3], base: [f64; 3], metallic: f64, roughness: f64, smith: Smith) -> [f64; 3] {
+        // Normalised in f64, as in `prefilter`.
+        let (n, v) = (normalize(n), normalize(v));
         let alpha = roughness * roughness;
         let a2 = alpha * alpha;
         let nv = dot(n, v);
