@@ -269,6 +269,8 @@ case "$cmd" in
         ensure_stable
         ensure_environments
         ensure_peers
+        # glTF-IBL-Sampler runs on Vulkan: lavapipe must be there before its runs below.
+        ensure_vulkan
         run cargo +stable build --release -p runner --bin runner --example figure_inputs
         run mkdir -p book/src/figures
         runner=target/release/runner
@@ -297,7 +299,6 @@ case "$cmd" in
         run bash scripts/mitsuba.sh --figure book/src/figures/mitsuba.md
         # What the tests measure against the peers and the exact references, written by
         # the tests themselves where SPLITSUM_FIGURES is set (tests/support/figure.rs).
-        ensure_vulkan
         ensure_browser
         ensure_viewer
         run env SPLITSUM_FIGURES=1 cargo +stable test --release -p splitsum-tests --test suite -- \
