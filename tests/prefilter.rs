@@ -222,22 +222,22 @@ fn reference_directions_need_not_be_unit_length() {
     let (s, sun) = (32u32, (2u32, 13u32, 17u32));
     let mut src = vec![Vec4::ONE; (6 * s * s) as usize];
     src[((sun.0 * s + sun.2) * s + sun.1) as usize] = Vec4::new(1e4, 1e4, 1e4, 1.0);
-    let env = splitsum_reference::Environment::new(&src, s);
-    // Half a texel from the bright texel's centre, towards its edge.
+    let env = reference::Environment::new(&src, s);
+    // On the bright texel's edge, half a texel from its centre: midway to its neighbour's.
     let c = reference::texel_dir(sun.0, sun.1, sun.2, s);
     let side = reference::texel_dir(sun.0, sun.1 + 1, sun.2, s);
-    let n = reference::normalize([0.0, 1.0, 2.0].map(|k| c[k as usize] * 0.5 + side[k as usize] * 0.5));
+    let n = reference::normalize(std::array::from_fn(|k| (c[k] + side[k]) * 0.5));
     let v = reference::normalize([n[0] + 0.3, n[1] - 0.2, n[2] + 0.4]);
     for r in [0.02, 0.05, 0.3] {
         let exact = env.prefilter(n, r);
-        let shaded = env.shade(n, v, [1.0; 3], 1.0, r, splitsum_reference::Smith::Correlated);
+        let shaded = env.shade(n, v, [1.0; 3], 1.0, r, reference::Smith::Correlated);
         for scale in [1.0 - 6e-8, 1.0 + 6e-8] {
             let off = n.map(|x| x * scale);
             let got = env.prefilter(off, r);
             let rel = (got[1] - exact[1]).abs() / exact[1];
             println!("r {r}: prefiltered {:.6e}, scaled by {scale}: off by {rel:.1e}", exact[1]);
             assert!(rel < 1e-6, "r {r}: {rel:e}");
-            let got = env.shade(off, v.map(|x| x * scale), [1.0; 3], 1.0, r, splitsum_reference::Smith::Correlated);
+            let got = env.shade(off, v.map(|x| x * scale), [1.0; 3], 1.0, r, reference::Smith::Correlated);
             let rel = (got[1] - shaded[1]).abs() / shaded[1];
             assert!(rel < 1e-6, "r {r}, shaded: {rel:e}");
         }

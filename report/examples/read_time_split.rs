@@ -6,15 +6,15 @@
 //! (`shaders/src/bright.rs`): `T` is the luminance of its `(K+1)`-th brightest texel; a
 //! texel brighter keeps `L·T/lum(L)` (the residual) and gives the rest to an excess list of
 //! at most `K` texels. The residual is baked with the defaults and read as the defaults
-//! read; each excess texel adds `E·∫_texel D(h)(n·l) dl / ∫_hemisphere D(h)(n·l) dl` with
-//! `n = v` = the lookup direction, the prefilter's own weight, integrated over the texel's
-//! sub-patches (eight to the lobe's width, as `reference::Environment::integrate`). The
-//! filter is linear, so this is the exact prefilter of the source wherever the residual's
-//! read is.
+//! read; each excess texel adds `E·∫_texel D(h)(n·l) dl / ∫_sphere D(h)(n·l) dl` with
+//! `n = v` = the lookup direction, the prefilter's own weight: the f64 reference's exact
+//! prefilter (`reference::Environment::prefilter`) of a level that holds the excess alone.
+//! The filter is linear, so this is the exact prefilter of the source wherever the
+//! residual's read is.
 //!
-//! **f32 hazard.** At `r ≤ 0.05` (`α ≤ 0.0025`) `n·h` differs from 1 by less than f32's
-//! epsilon across the lobe; `D` must be evaluated from `n·l` in f64 here (or, in a shader,
-//! from `1 − n·h = |n − h|²/2`), or the excess of a 10⁴ sun reads hundreds of percent off.
+//! **f32 hazard, for a shader.** At `r ≤ 0.05` (`α ≤ 0.0025`) `n·h` differs from 1 by less
+//! than f32's epsilon across the lobe; `D` must come from `1 − n·h = |n − h|²/2` or from
+//! `n·l`, not from `n·h` squared, or the excess of a 10⁴ sun reads hundreds of percent off.
 //!
 //! `cargo run --release -p splitsum-report --example read_time_split -- near|anywhere
 //! POINTS K [ENVIRONMENT...]`: `POINTS` lookups per roughness band and environment, within
@@ -29,111 +29,41 @@ use splitsum::environment::Environment;
 use splitsum::measured::Set;
 use splitsum::settings::Settings;
 use splitsum::texture::Cube;
+use splitsum_report::measurement::rel64;
 use splitsum_report::sets::MEMBERS;
-use splitsum_shaders::cubemap::{self, CubeLayout};
-use splitsum_shaders::glam::{Vec2, Vec3};
+use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::glam::{Vec3, Vec4};
 use splitsum_shaders::sampling;
 use splitsum_shaders::shade::{self, ShadeOptions};
-use std::f64::consts::PI;
 
 /// The roughness bands of `runner report`'s lookups.
 const BANDS: [(f32, f32); 8] = [(0.02, 0.05), (0.05, 0.1), (0.1, 0.15), (0.15, 0.2), (0.2, 0.35), (0.35, 0.5), (0.5, 0.75), (0.75, 1.0)];
 
 fn unit(v: Vec3) -> [f64; 3] {
-    let a = [v.x as f64, v.y as f64, v.z as f64];
-    let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    a.map(|x| x / l)
+    splitsum_reference::normalize([v.x as f64, v.y as f64, v.z as f64])
 }
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn luminance(c: [f64; 3]) -> f64 {
-    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
-}
-
-fn relative(got: [f64; 3], want: [f64; 3]) -> f64 {
-    (luminance(got) - luminance(want)).abs() / luminance(want).max(1e-12)
-}
-
-/// GGX's `D(h)` for `n = v` from `c = n·l`: `n·h = √((1 + c)/2)`.
-fn ggx(c: f64, a2: f64) -> f64 {
-    let nh2 = (1.0 + c) / 2.0;
-    let q = nh2 * (a2 - 1.0) + 1.0;
-    a2 / (PI * q * q)
-}
-
-/// `∫ D(h)(n·l) dl` over the hemisphere for `n = v`, by the midpoint rule in `n·h`, its
-/// points crowded towards `n·h = 1` (`n·h = 1 − (1 − 1/√2) t⁴`), where a narrow lobe lives.
-fn normaliser(a2: f64) -> f64 {
-    let (steps, c0) = (20_000, std::f64::consts::FRAC_1_SQRT_2);
-    (0..steps)
-        .map(|i| {
-            let t = (i as f64 + 0.5) / steps as f64;
-            let nh = 1.0 - (1.0 - c0) * t.powi(4);
-            let dnh = (1.0 - c0) * 4.0 * t.powi(3) / steps as f64;
-            let q = nh * nh * (a2 - 1.0) + 1.0;
-            // dl = 4 (n·h) dω_h for n = v; n·l = 2(n·h)² − 1.
-            a2 / (PI * q * q) * (2.0 * nh * nh - 1.0) * 4.0 * nh * 2.0 * PI * dnh
-        })
-        .sum()
-}
-
-/// One texel of the excess list: face, x, y, excess radiance.
-type Excess = (u32, u32, u32, [f64; 3]);
 
 /// A set's sums over its environments: (defaults, split) per band, and how many.
 type SetSums = (Set, usize, [(f64, f64); BANDS.len()]);
 
-/// Splits level 0 (`s`² faces) at the `(K+1)`-th brightest texel: the residual level and
-/// the excess list.
-fn split(level: &[splitsum_shaders::glam::Vec4], s: u32, keep: usize) -> (Vec<splitsum_shaders::glam::Vec4>, Vec<Excess>) {
-    let lum = |t: &splitsum_shaders::glam::Vec4| 0.2126 * t.x + 0.7152 * t.y + 0.0722 * t.z;
+/// Splits level 0 at the `(K+1)`-th brightest texel: the residual level, the level that
+/// holds the excess alone, and how many texels were split.
+fn split(level: &[Vec4], keep: usize) -> (Vec<Vec4>, Vec<Vec4>, usize) {
+    let lum = |t: &Vec4| 0.2126 * t.x + 0.7152 * t.y + 0.0722 * t.z;
     let mut sorted: Vec<f32> = level.iter().map(lum).collect();
     sorted.sort_by(|a, b| b.total_cmp(a));
     let threshold = sorted[keep.min(sorted.len() - 1)].max(1e-6);
-    let mut residual = level.to_vec();
-    let mut excess = Vec::new();
+    let (mut residual, mut excess, mut count) = (level.to_vec(), vec![Vec4::ZERO; level.len()], 0);
     for (i, t) in level.iter().enumerate() {
         let l = lum(t);
         if l > threshold {
             let kept = t.truncate() * (threshold / l);
             residual[i] = kept.extend(t.w);
-            let e = t.truncate() - kept;
-            let i = i as u32;
-            excess.push((i / (s * s), i % s, (i / s) % s, [e.x as f64, e.y as f64, e.z as f64]));
+            excess[i] = (t.truncate() - kept).extend(t.w);
+            count += 1;
         }
     }
-    (residual, excess)
-}
-
-/// The excess list's exact prefiltered radiance along `d` at roughness `r`.
-fn excess_radiance(excess: &[Excess], s: u32, d: Vec3, r: f32) -> [f64; 3] {
-    let (a, n) = ((r as f64) * (r as f64), unit(d));
-    let a2 = a * a;
-    let norm = normaliser(a2);
-    let mut sum = [0.0; 3];
-    for &(face, x, y, e) in excess {
-        let omega = cubemap::texel_solid_angle(x, y, s) as f64;
-        let angle = dot(unit(cubemap::texel_dir(face, x, y, s)), n).clamp(-1.0, 1.0).acos();
-        // Eight sub-patches to the lobe's width in l (2α), or to the angle away from it.
-        let k = ((8.0 * omega.sqrt() / (2.0 * a.max(0.5 * angle))).ceil() as u32).clamp(1, 1024);
-        let mut w = 0.0;
-        for j in 0..k {
-            for i in 0..k {
-                let uv = Vec2::new((x as f32 + (i as f32 + 0.5) / k as f32) / s as f32, (y as f32 + (j as f32 + 0.5) / k as f32) / s as f32);
-                let c = dot(unit(cubemap::face_uv_to_dir(face, uv)), n);
-                if c > 0.0 {
-                    w += ggx(c, a2) * c * omega / (k * k) as f64;
-                }
-            }
-        }
-        for ch in 0..3 {
-            sum[ch] += e[ch] * w / norm;
-        }
-    }
-    sum
+    (residual, excess, count)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -155,10 +85,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let baked = splitsum::bake::bake_for_display(&Backend::Cpu, &env, &Settings::default())?;
         let s = baked.shape().specular_size;
         let cube = splitsum::bake::host_source_cube(&Backend::Cpu, &env, &Settings { source_size: Some(s), size: s, ..Settings::default() })?;
-        let (residual, excess) = split(cube.level(0), s, keep);
+        let (residual, excess, count) = split(cube.level(0), keep);
         let rest = Environment::Cube(Cube { layout: CubeLayout::new(s, 1), texels: residual });
         let rest = splitsum::bake::bake_for_display(&Backend::Cpu, &rest, &Settings::default())?;
         let reference = splitsum_reference::Environment::new(cube.level(0), s);
+        let excess = splitsum_reference::Environment::new(&excess, s);
         let b = reference.brightest();
         let sun = Vec3::new(b[0] as f32, b[1] as f32, b[2] as f32).normalize();
         let (t, bt) = sampling::orthonormal_basis(sun);
@@ -168,7 +99,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         let set = sets.iter_mut().find(|x| x.0 == m.set).expect("both sets are listed");
         set.1 += 1;
-        print!("{:<22} {:>3} texels split |", m.name, excess.len());
+        print!("{:<22} {count:>3} texels split |", m.name);
         for (band, &(lo, hi)) in BANDS.iter().enumerate() {
             let errors: Vec<(f64, f64)> = (0..points)
                 .into_par_iter()
@@ -179,8 +110,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let turn = (i as f32 + 0.5) / points as f32 * std::f32::consts::TAU;
                     let d = (sun * angle.cos() + (t * turn.cos() + bt * turn.sin()) * angle.sin()).normalize();
                     let exact = reference.prefilter(unit(d), r as f64);
-                    let (rest, extra) = (read(&rest, d, r), excess_radiance(&excess, s, d, r));
-                    (relative(read(&baked, d, r), exact), relative([0, 1, 2].map(|c| rest[c] + extra[c]), exact))
+                    let (rest, extra) = (read(&rest, d, r), excess.prefilter(unit(d), r as f64));
+                    (rel64(read(&baked, d, r), exact), rel64([0, 1, 2].map(|c| rest[c] + extra[c]), exact))
                 })
                 .collect();
             let mean = |f: fn(&(f64, f64)) -> f64| 100.0 * errors.iter().map(f).sum::<f64>() / errors.len() as f64;
