@@ -4,7 +4,7 @@
 
 use splitsum::Backend;
 use splitsum::Product;
-use splitsum::bake::BakedEnvironment;
+use splitsum::reading::BakedEnvironment;
 use splitsum::cache::{Cache, Lookup, Rejection};
 use splitsum::cost::Calibration;
 use splitsum::environment::Environment;

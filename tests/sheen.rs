@@ -205,12 +205,12 @@ fn sheen_shading_under_a_constant_sky_is_the_sheen_albedo() {
         irradiance_size: 1,
         lut_size: 1,
         source_size: 1,
-        source_levels: 1,
         irradiance_levels: 1,
         sheen_size: size,
         sheen_levels: levels,
         sheen_mapping: RoughnessMapping::Linear as u32,
         sheen_table_size: splitsum::table::SHEEN_TABLE_SIZE,
+        excess_entries: 0,
     };
     let mut worst = 0.0f64;
     for c in [1.0f32, 1e4, 1e6] {

@@ -185,12 +185,12 @@ fn the_shading_ladder_keeps_a_constant_sky_constant() {
             irradiance_size: size,
             lut_size: 4,
             source_size: size,
-            source_levels: 1,
             irradiance_levels: 1,
             sheen_size: size,
             sheen_levels: cube.layout.levels,
             sheen_mapping: RoughnessMapping::Linear as u32,
             sheen_table_size: splitsum::table::SHEEN_TABLE_SIZE,
+            excess_entries: 0,
         };
         for n in hard_directions().into_iter().filter(|n| n.length() > 0.5) {
             let (t, _) = sampling::orthonormal_basis(n);
@@ -269,7 +269,7 @@ fn extreme_environment_bakes_and_renders_finite() {
         assert!(baked.table(Product::BrdfTable).unwrap().texels.iter().all(|t| t.is_finite()));
     }
     // Rendered on the GPU in linear radiance, with lights of 10⁶ and mirror spheres.
-    let baked = bake::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();
+    let baked = splitsum::reading::bake_for_display(&Backend::Cpu, &env, &settings).unwrap();
     let Backend::Gpu(gpu) = support::gpu() else { unreachable!() };
     let scene = splitsum_display::render::GpuScene::new(gpu, &baked);
     let mut view = splitsum_display::render::ViewState::default();

@@ -8,6 +8,7 @@ mod choices;
 mod cli;
 mod commands;
 mod equirect;
+mod excess;
 mod files;
 mod fuzz;
 mod irradiance;

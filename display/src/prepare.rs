@@ -3,7 +3,8 @@
 //! build is there.
 
 use splitsum::Backend;
-use splitsum::bake::{BakedEnvironment, Timing, bake_job, check_duration};
+use splitsum::bake::{Timing, check_duration};
+use splitsum::reading::{BakedEnvironment, for_display};
 use splitsum::error::Result;
 
 /// What happened to a scene's bake.
@@ -47,9 +48,7 @@ pub struct SceneBake {
 
 /// Bakes what `plan` keeps of `env` into what the display reads (stand-ins for the rest).
 pub fn bake_plan(backend: &Backend, env: &splitsum::Environment, plan: &crate::plan::Plan) -> Result<(BakedEnvironment, Vec<Timing>)> {
-    let baked = bake_job(backend, env, &plan.job)?;
-    let timings = baked.timings.clone();
-    Ok((baked.into_display(plan.job.mapping), timings))
+    for_display(backend, env, &plan.job)
 }
 
 /// Plans `scene` and bakes it, or takes it from `cache` when an entry for exactly this

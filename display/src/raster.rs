@@ -7,7 +7,7 @@
 use crate::model::{Model, Texture};
 use rayon::prelude::*;
 use splitsum::Product;
-use splitsum::bake::BakedEnvironment;
+use splitsum::reading::BakedEnvironment;
 use splitsum_shaders::glam::{Vec2, Vec3, Vec4};
 use splitsum_shaders::scene::{self, Frame};
 use splitsum_shaders::surface::{self, Texels};
@@ -77,6 +77,7 @@ struct Fragment {
 /// Renders the scene with `model` in it: the ray-cast spheres and sky, then every triangle
 /// depth-tested against them. Returns display values, row 0 at the top.
 pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4> {
+    let specular = env.specular_buffer();
     let (w, h) = (frame.width as usize, frame.height as usize);
     let mut colour = vec![Vec3::ZERO; w * h];
     let mut depth = vec![1.0f32; w * h];
@@ -86,7 +87,7 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
             let (c, d) = scene::radiance_depth(
                 frame,
                 env.cube(Product::SourceCube).level(0),
-                &env.cube(Product::Specular).texels,
+                &specular,
                 &env.cube(Product::Irradiance).texels,
                 &env.table(Product::BrdfTable).texels,
                 &env.cube(Product::Sheen).texels,
@@ -188,7 +189,7 @@ pub fn render(env: &BakedEnvironment, frame: &Frame, model: &Model) -> Vec<Vec4>
         *c = scene::shade_point(
             frame,
             prim.material.options,
-            &env.cube(Product::Specular).texels,
+            &specular,
             &env.cube(Product::Irradiance).texels,
             &env.table(Product::BrdfTable).texels,
             &env.cube(Product::Sheen).texels,

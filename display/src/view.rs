@@ -5,7 +5,7 @@
 use crate::model::Model;
 use crate::render::{GpuModel, GpuScene, ViewState};
 use splitsum::backend::gpu::Gpu;
-use splitsum::bake::BakedEnvironment;
+use splitsum::reading::BakedEnvironment;
 use splitsum::error::{Error, Result};
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::shade::{self, DiffuseModel, FresnelForm, ShadeOptions, SpecularModel};

@@ -56,9 +56,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     continue;
                 }
                 let env = splitsum::environment::load(&dir.join(format!("{s}.exr")), false)?.0;
-                let baked = splitsum::bake::bake_for_display(&backend, &env, &Settings::default())?;
+                let baked = splitsum::reading::bake_for_display(&backend, &env, &Settings::default())?;
                 let raw: Vec<f32> = std::fs::read(&points)?.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
                 let shape = baked.shape();
+                let specular = baked.specular_buffer();
                 for &r in &ROUGHNESS {
                     let m = Material {
                         base_color: Vec3::ONE,
@@ -76,7 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             let (n, v) = (Vec3::new(p[0], p[1], p[2]), Vec3::new(p[3], p[4], p[5]));
                             let sample = shade::ibl_sample(
                                 shape,
-                                &baked.cube(Product::Specular).texels,
+                                &specular,
                                 &baked.cube(Product::Irradiance).texels,
                                 &baked.table(Product::BrdfTable).texels,
                                 opts,

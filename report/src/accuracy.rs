@@ -29,6 +29,7 @@ use rayon::prelude::*;
 use splitsum::Product;
 use splitsum::backend::Backend;
 use splitsum::bake;
+use splitsum::reading;
 use splitsum::environment::Environment;
 use splitsum::error::Result;
 use splitsum::settings::{Settings, TableMethod};
@@ -74,6 +75,22 @@ impl Method {
     fn options(&self) -> ShadeOptions {
         ShadeOptions { flags: self.flags | ShadeOptions::IBL, ..ShadeOptions::DEFAULT }
     }
+
+    /// Whether it reads a split source as splitsum's renderer does (`reading::for_display`);
+    /// the seed and the engine targets' reads stand for other renderers, which read the
+    /// whole cubes of their files.
+    fn reads_split(&self) -> bool {
+        !matches!(self.kind, Kind::Seed | Kind::KhronosBevyLookup | Kind::FilamentLookup)
+    }
+
+    /// Its bake, as its renderer reads it.
+    fn bake(&self, backend: &Backend, env: &Environment) -> Result<reading::BakedEnvironment> {
+        if self.reads_split() {
+            return reading::bake_for_display(backend, env, &self.settings);
+        }
+        let job = self.settings.resolve(splitsum::InputShape::of(env), splitsum::Products::DISPLAY)?;
+        Ok(bake::bake_job(backend, env, &job)?.into_display(job.mapping))
+    }
 }
 
 /// One shading point and its references.
@@ -87,6 +104,9 @@ struct ShadingPoint {
     full_schlick: [f64; 3],
     /// Exact `E/π` along `n`.
     irradiance: [f64; 3],
+    /// The same two of the residual of the source split for reading
+    /// (`reading::split_for_reading`): what a split read's cubes stand for.
+    residual: ([f64; 3], [[f64; 3]; 4]),
     /// Exact prefiltered radiance along each direction the one fetch may read along
     /// (`shade::read_direction`), indexed by [`read_index`].
     prefiltered: [[f64; 3]; 4],
@@ -162,6 +182,7 @@ impl Points {
     pub fn new(source: &Cube, shading: u32, lookups: u32) -> Self {
         let s = source.layout.size;
         let env = reference::Environment::new(source.level(0), s);
+        let rest = reference::Environment::new(&reading::split_for_reading(source).0, s);
         let sun = vec(env.brightest()).normalize();
         let base = Vec3::new(0.9, 0.6, 0.3);
         let mut pts = Vec::new();
@@ -205,26 +226,29 @@ impl Points {
                     let (a, b) = reference::brdf_lut_with(nv, r, 1e-7, smith);
                     Vec2::new(a as f32, b as f32)
                 };
+                // The exact prefiltered radiance of `env` along the four read directions, each
+                // summed once (most coincide away from grazing views).
+                let prefiltered = |env: &reference::Environment| {
+                    let dirs: [Vec3; 4] = std::array::from_fn(|k| shade::read_direction(READ_FLAGS[k], n, v, m.roughness));
+                    let mut sums: [[f64; 3]; 4] = [[0.0; 3]; 4];
+                    for k in 0..4 {
+                        sums[k] = match (0..k).find(|&j| dirs[j] == dirs[k]) {
+                            Some(j) => sums[j],
+                            None => env.prefilter(arr(dirs[k]), r),
+                        };
+                    }
+                    sums
+                };
+                let irradiance = |env: &reference::Environment| env.integrate(|l| [reference::dot(na, l).max(0.0) / std::f64::consts::PI; 3], |_| f64::INFINITY).0;
                 ShadingPoint {
                     material: m,
                     n,
                     v,
                     truth: env.shade(na, va, b, m.metallic as f64, r, reference::Smith::Correlated),
                     full_schlick: env.shade(na, va, b, m.metallic as f64, r, reference::Smith::Schlick),
-                    irradiance: env.integrate(|l| [reference::dot(na, l).max(0.0) / std::f64::consts::PI; 3], |_| f64::INFINITY).0,
-                    prefiltered: {
-                        // The four read directions, each summed once (most coincide away
-                        // from grazing views).
-                        let dirs: [Vec3; 4] = std::array::from_fn(|k| shade::read_direction(READ_FLAGS[k], n, v, m.roughness));
-                        let mut sums: [[f64; 3]; 4] = [[0.0; 3]; 4];
-                        for k in 0..4 {
-                            sums[k] = match (0..k).find(|&j| dirs[j] == dirs[k]) {
-                                Some(j) => sums[j],
-                                None => env.prefilter(arr(dirs[k]), r),
-                            };
-                        }
-                        sums
-                    },
+                    irradiance: irradiance(&env),
+                    prefiltered: prefiltered(&env),
+                    residual: (irradiance(&rest), prefiltered(&rest)),
                     table: [table(reference::Smith::Schlick), table(reference::Smith::Correlated)],
                 }
             })
@@ -286,22 +310,22 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
     let device = crate::measurement::Device::of(backend);
     let mut rows = Vec::new();
     // Methods that differ only in their shading share one bake (and its time).
-    let mut last: Option<(Settings, bake::BakedEnvironment, f64)> = None;
+    let mut last: Option<(Settings, reading::BakedEnvironment, f64)> = None;
     // Warm-up, outside the timings: the first bake on a backend pays for its pipelines and
     // threads (measured: 0.61 s against 0.02 s for the same quick bake), which would be
     // charged to the first method. A small bake of each method's kernels does it.
     if let Some(first) = methods.first() {
-        bake::bake_for_display(backend, env, &Settings { size: 8, source_size: Some(8), mips: None, irradiance_source: None, sh_source: None, ..first.settings.clone() })?;
+        reading::bake_for_display(backend, env, &Settings { size: 8, source_size: Some(8), mips: None, irradiance_source: None, sh_source: None, ..first.settings.clone() })?;
     }
     for method in methods {
-        if last.as_ref().is_none_or(|(s, _, _)| *s != method.settings) {
+        if last.as_ref().is_none_or(|(s, b, _)| *s != method.settings || b.excess.is_empty() == method.reads_split()) {
             let start = Instant::now();
-            let baked = bake::bake_for_display(backend, env, &method.settings)?;
+            let baked = method.bake(backend, env)?;
             last = Some((method.settings.clone(), baked, start.elapsed().as_secs_f64() * 1e3));
         }
         let (_, baked, ms) = last.as_ref().expect("baked above");
         let ms = *ms;
-        let (spec, irr, table, shape) = (baked.cube(Product::Specular), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
+        let (spec, irr, table, shape) = (baked.specular_buffer(), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
         let opts = method.options();
         let read = read_index(opts.flags);
         let correlated = usize::from(method.settings.lut_masking.unwrap_or(method.settings.lut_method.default_masking()) == Masking::SmithCorrelated);
@@ -310,9 +334,21 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             .iter()
             .map(|p| {
                 let m = &p.material;
-                let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, opts, m, p.n, p.v);
+                let s = shade::ibl_sample(shape, &spec, &irr.texels, &table.texels, opts, m, p.n, p.v);
                 let shown = shade::ibl(opts, m, p.n, p.v, s);
-                let exact = IblSample { prefiltered: vec(p.prefiltered[read]), irradiance: vec(p.irradiance), brdf: p.table[correlated] };
+                // The same read from exact ingredients: where the bake was split, the exact
+                // residual's and this bake's excess list, read as the shading reads it.
+                let exact = if baked.excess.is_empty() {
+                    IblSample { prefiltered: vec(p.prefiltered[read]), irradiance: vec(p.irradiance), brdf: p.table[correlated] }
+                } else {
+                    let brdf = p.table[correlated];
+                    let base = splitsum_shaders::cubemap::CubeLayout::new(shape.specular_size, shape.specular_levels).texel_count();
+                    IblSample {
+                        prefiltered: vec(p.residual.1[read]) + shade::excess_lobe_radiance(shape, &spec, opts, m, p.n, p.v, brdf),
+                        irradiance: vec(p.residual.0) + splitsum_shaders::excess::irradiance(&spec, base, shape.excess_entries, p.n),
+                        brdf,
+                    }
+                };
                 let split = shade::ibl(opts, m, p.n, p.v, exact);
                 let full = if correlated == 1 { p.truth } else { p.full_schlick };
                 PointErrors {
@@ -369,7 +405,7 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
             .lookups
             .iter()
             .map(|q| {
-                let got = shade::prefiltered(shape, &spec.texels, opts.flags, q.dir, q.roughness).truncate();
+                let got = shade::prefiltered(shape, &spec, opts.flags, q.dir, q.roughness).truncate();
                 (q.roughness, q.near_sun, rel(got, q.exact))
             })
             .collect();

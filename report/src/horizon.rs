@@ -13,7 +13,7 @@ use crate::skies;
 use rayon::prelude::*;
 use splitsum::Product;
 use splitsum::backend::Backend;
-use splitsum::bake;
+use splitsum::reading;
 use splitsum::error::Result;
 use splitsum::settings::Settings;
 use splitsum_reference as reference;
@@ -76,7 +76,7 @@ pub fn measure(backend: &Backend, width: u32, radiance: f32, size: u32) -> Resul
     let mut rows = Vec::new();
     let mut scenes = Vec::new();
     for env in [&lit, &dark] {
-        let baked = bake::bake_for_display(backend, env, &settings)?;
+        let baked = reading::bake_for_display(backend, env, &settings)?;
         let source = baked.cube(Product::SourceCube);
         let refenv = reference::Environment::new(source.level(0), source.layout.size);
         let truth: Vec<[f64; 3]> =
@@ -85,8 +85,8 @@ pub fn measure(backend: &Backend, width: u32, radiance: f32, size: u32) -> Resul
     }
     for rung in 0..shade::LADDER_RUNGS {
         let opts = ShadeOptions::DEFAULT.with_fetches(1 << rung);
-        let errors = |(baked, truth): &(bake::BakedEnvironment, Vec<[f64; 3]>)| -> Vec<f64> {
-            let (spec, irr, table, shape) = (baked.cube(Product::Specular), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
+        let errors = |(baked, truth): &(reading::BakedEnvironment, Vec<[f64; 3]>)| -> Vec<f64> {
+            let (spec, irr, table, shape) = (baked.specular_buffer(), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
             pts.iter()
                 .zip(truth)
                 .map(|(&(n, v, r), t)| {
@@ -99,7 +99,7 @@ pub fn measure(backend: &Backend, width: u32, radiance: f32, size: u32) -> Resul
                         sheen_color: Vec3::ZERO,
                         sheen_roughness: 0.0,
                     };
-                    let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, opts, &m, n, v);
+                    let s = shade::ibl_sample(shape, &spec, &irr.texels, &table.texels, opts, &m, n, v);
                     let got = shade::ibl(opts, &m, n, v, s);
                     rel(got, *t)
                 })

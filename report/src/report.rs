@@ -133,7 +133,7 @@ pub fn run(
     let sky_source = bake::host_source_cube(&Backend::Cpu, &sky, &Settings { source_size: Some(src), size: src, ..Settings::default() })?;
     for (what, e, cube) in [(name.to_string(), env, &acc_source), ("a clear sky with a sun of 10^4 (generated)".to_string(), &sky, &sky_source)] {
         let _step = splitsum::progress::step(&format!("report: error on surfaces of {what} (f64 sphere grid)"), None);
-        let baked = bake::bake_for_display(&backends[0], e, &Settings { size: src, source_size: Some(src), ..defaults.clone() })?;
+        let baked = splitsum::reading::bake_for_display(&backends[0], e, &Settings { size: src, source_size: Some(src), ..defaults.clone() })?;
         let exact = reference::Environment::new(cube.level(0), cube.layout.size);
         maps.push((what, crate::surface::error_map(&baked, &exact)));
     }
@@ -379,15 +379,15 @@ fn irradiance_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &Referenc
 fn shaded_rows(backend: &Backend, b: &Device, sweep: &Sweep, refs: &References, env: &Environment) -> Result<Vec<Measurement>> {
     let mut rows = Vec::new();
     for settings in &sweep.qualities {
-        let (baked, ms) = timed(|| bake::bake_for_display(backend, env, settings))?;
-        let (spec, irr, table, shape) = (baked.cube(Product::Specular), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
+        let (baked, ms) = timed(|| splitsum::reading::bake_for_display(backend, env, settings))?;
+        let (spec, irr, table, shape) = (baked.specular_buffer(), baked.cube(Product::Irradiance), baked.table(Product::BrdfTable), baked.shape());
         for &(lo, hi) in &VIEWS {
             let errors: Vec<f64> = refs
                 .shading
                 .iter()
                 .filter(|p| in_view(p, (lo, hi)))
                 .map(|p| {
-                    let s = shade::ibl_sample(shape, &spec.texels, &irr.texels, &table.texels, ShadeOptions::DEFAULT, &p.material, p.n, p.v);
+                    let s = shade::ibl_sample(shape, &spec, &irr.texels, &table.texels, ShadeOptions::DEFAULT, &p.material, p.n, p.v);
                     rel(shade::ibl(ShadeOptions::DEFAULT, &p.material, p.n, p.v, s), p.full)
                 })
                 .collect();

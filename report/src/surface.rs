@@ -10,7 +10,7 @@
 use crate::measurement::{arr, rel};
 use rayon::prelude::*;
 use splitsum::Product;
-use splitsum::bake::BakedEnvironment;
+use splitsum::reading::BakedEnvironment;
 use splitsum_reference as reference;
 use splitsum_shaders::glam::Vec3;
 use splitsum_shaders::shade::{self, Material, ShadeOptions};
@@ -100,12 +100,13 @@ pub fn error_map(baked: &BakedEnvironment, env: &reference::Environment) -> Erro
     let opts = ShadeOptions::DEFAULT;
     let opts = ShadeOptions { flags: (opts.flags & !ShadeOptions::DIRECT) | ShadeOptions::IBL, ..opts };
     let shape = baked.shape();
+    let specular = baked.specular_buffer();
     let shaded: Vec<(Vec3, [f64; 3])> = points
         .par_iter()
         .map(|(_, _, m, n)| {
             let s = shade::ibl_sample(
                 shape,
-                &baked.cube(Product::Specular).texels,
+                &specular,
                 &baked.cube(Product::Irradiance).texels,
                 &baked.table(Product::BrdfTable).texels,
                 opts,

@@ -9,6 +9,8 @@
 //! Data flow: an equirect environment ([`equirect`]) is resampled to a cube and its mip
 //! chain ([`cubemap`]); from it come the GGX-prefiltered specular cube ([`prefilter`]),
 //! the diffuse irradiance ([`irradiance`]); the BRDF table ([`lut`]) needs no environment.
+//! A renderer's cubes may be baked from a split source, whose brightest texels [`excess`]
+//! adds back exactly at every read.
 //! [`brdf`] holds the reflectance models, [`sampling`] the sample generators and [`math`]
 //! the elementary functions both backends evaluate identically.
 #![cfg_attr(not(test), warn(unused_crate_dependencies))]
@@ -21,6 +23,7 @@ pub mod choice;
 pub mod cubemap;
 pub mod display;
 pub mod equirect;
+pub mod excess;
 pub mod half;
 pub mod irradiance;
 pub mod kernels;

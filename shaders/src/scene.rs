@@ -7,6 +7,7 @@
 //! `b = (o−c)·d`, `c = |o−c|² − R²` (Pharr, Jakob & Humphreys, *PBRT* 4e §6.2.2).
 
 use crate::cubemap::{self, CubeLayout};
+use crate::prefilter::RoughnessMapping;
 use crate::shade::{self, EnvironmentShape, Material, ShadeOptions};
 use crate::{math, sampling, tonemap};
 use bytemuck::{Pod, Zeroable};
@@ -264,11 +265,23 @@ pub fn radiance(frame: &Frame, source: &[Vec4], specular: &[Vec4], irradiance: &
 pub fn sky(frame: &Frame, source: &[Vec4], specular: &[Vec4], dir: Vec3) -> Vec3 {
     let blur = frame.sky_blur;
     if blur > 0.0 {
-        let layout = CubeLayout::new(frame.shape.specular_size, frame.shape.specular_levels);
-        cubemap::sample_lod(specular, layout, dir, blur).truncate()
+        let shape = frame.shape;
+        let layout = CubeLayout::new(shape.specular_size, shape.specular_levels);
+        let c = cubemap::sample_lod(specular, layout, dir, blur).truncate();
+        if shape.excess_entries == 0 {
+            return c;
+        }
+        // A cube baked from a split source: its excess at the roughness between the two
+        // mips the blur reads.
+        let top = (shape.specular_levels - 1) as f32;
+        let at = math::clamp(blur, 0.0, top);
+        let m0 = math::floor(at);
+        let mapping = RoughnessMapping::from_u32(shape.mapping);
+        let (r0, r1) = (mapping.roughness(m0 as u32, shape.specular_levels), mapping.roughness(math::min(m0 + 1.0, top) as u32, shape.specular_levels));
+        let r = r0 + (r1 - r0) * (at - m0);
+        c + crate::excess::prefiltered_excess(specular, layout.texel_count(), shape.excess_entries, dir, r, Vec3::ZERO).truncate()
     } else {
-        let layout = CubeLayout::new(frame.shape.source_size, frame.shape.source_levels);
-        cubemap::sample_bilinear(source, layout, 0, dir).truncate()
+        cubemap::sample_bilinear(source, CubeLayout::new(frame.shape.source_size, 1), 0, dir).truncate()
     }
 }
 

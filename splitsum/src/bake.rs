@@ -2,7 +2,8 @@
 //! BRDF table that [`Products`] asks for, on any backend ([`Kernels`]). [`make`] leaves the
 //! products where the backend made them (device buffers on the GPU, for
 //! `crate::textures`); [`bake`] reads them into host memory ([`Baked`]) for files, reports
-//! and the CPU rasteriser. Everything else (plans, caches, the display) calls these.
+//! and the CPU rasteriser. Everything else (plans, caches, the display) calls these;
+//! what a renderer reads is `crate::reading`'s, which runs this sequence twice.
 
 use crate::backend::{Backend, Cpu, Kernels, Prefilter, with_kernels};
 use crate::placement::{self, Place};
@@ -15,9 +16,7 @@ use crate::settings::{InputShape, Job, Product, Products, Settings};
 use crate::texture::{Cube, Lut, Sh9};
 use serde::Serialize;
 use splitsum_shaders::cubemap::{self, CubeLayout};
-use splitsum_shaders::prefilter::RoughnessMapping;
 use std::collections::BTreeMap;
-use splitsum_shaders::shade::EnvironmentShape;
 use web_time::Instant;
 
 /// Wall time of one step, and what was estimated for it as it started.
@@ -324,90 +323,6 @@ pub fn empty_cube() -> Cube {
 /// A 1×1 table of zeros: the stand-in for a table a plan leaves out.
 pub fn empty_table() -> Lut {
     Lut { size: 1, texels: vec![Default::default()] }
-}
-
-impl Baked {
-    /// What a renderer reads: the products baked, the source cube's level 0 (the sharp sky)
-    /// in place of the source cube, and the roughness of the specular mips.
-    pub fn into_display(mut self, mapping: RoughnessMapping) -> BakedEnvironment {
-        if let Some(Item::Cube(source)) = self.take(Product::SourceCube) {
-            self.insert(Product::SourceCube, Item::Cube(source.levels(0, 0)));
-        }
-        let mut env = BakedEnvironment { cubes: BTreeMap::new(), tables: BTreeMap::new(), mapping };
-        for (p, item) in self.items {
-            match item {
-                Item::Cube(c) => {
-                    env.cubes.insert(p, c);
-                }
-                Item::Table(t) => {
-                    env.tables.insert(p, t);
-                }
-                Item::Coefficients(_) => {}
-            }
-        }
-        env
-    }
-}
-
-/// What a renderer reads, in host memory: the cubes (the sharp sky, the specular,
-/// irradiance and sheen cubes) and the tables (the BRDF table, the sheen tables) baked,
-/// and the roughness of the specular mips. A product not baked reads as a 1×1 stand-in of
-/// zeros (nothing reads it).
-#[derive(Clone)]
-pub struct BakedEnvironment {
-    /// The cubes baked (the source cube: its level 0 only).
-    pub cubes: BTreeMap<Product, Cube>,
-    /// The tables baked.
-    pub tables: BTreeMap<Product, Lut>,
-    /// Roughness of the specular mips.
-    pub mapping: RoughnessMapping,
-}
-
-static EMPTY_CUBE: std::sync::LazyLock<Cube> = std::sync::LazyLock::new(empty_cube);
-static EMPTY_TABLE: std::sync::LazyLock<Lut> = std::sync::LazyLock::new(empty_table);
-
-impl BakedEnvironment {
-    /// The cube `p`, or a 1×1 stand-in of zeros.
-    pub fn cube(&self, p: Product) -> &Cube {
-        self.cubes.get(&p).unwrap_or(&EMPTY_CUBE)
-    }
-
-    /// The table `p`, or a 1×1 stand-in of zeros.
-    pub fn table(&self, p: Product) -> &Lut {
-        self.tables.get(&p).unwrap_or(&EMPTY_TABLE)
-    }
-
-    /// The display's exposure for this environment (`preview::auto_exposure`, the one
-    /// rule: a white Lambert surface at 0.5 on average before the tone curve).
-    pub fn auto_exposure(&self) -> f32 {
-        crate::preview::auto_exposure(self.cube(Product::SourceCube))
-    }
-
-    /// The shapes the shaders need.
-    pub fn shape(&self) -> EnvironmentShape {
-        let (source, specular, irradiance, sheen) =
-            (self.cube(Product::SourceCube), self.cube(Product::Specular), self.cube(Product::Irradiance), self.cube(Product::Sheen));
-        EnvironmentShape {
-            specular_size: specular.layout.size,
-            specular_levels: specular.layout.levels,
-            mapping: self.mapping as u32,
-            irradiance_size: irradiance.layout.size,
-            lut_size: self.table(Product::BrdfTable).size,
-            source_size: source.layout.size,
-            source_levels: 1,
-            irradiance_levels: irradiance.layout.levels,
-            sheen_size: sheen.layout.size,
-            sheen_levels: sheen.layout.levels,
-            sheen_mapping: Product::Sheen.mapping(self.mapping) as u32,
-            sheen_table_size: self.table(Product::SheenTables).size,
-        }
-    }
-}
-
-/// Bakes what a renderer reads ([`Products::DISPLAY`]) of `env` on `backend`.
-pub fn bake_for_display(backend: &Backend, env: &Environment, settings: &Settings) -> Result<BakedEnvironment> {
-    let job = settings.resolve(InputShape::of(env), Products::DISPLAY)?;
-    Ok(bake_job(backend, env, &job)?.into_display(job.mapping))
 }
 
 /// The source cube of `env` for `settings` (with its full mip chain) on `backend`, in

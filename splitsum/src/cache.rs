@@ -9,7 +9,7 @@
 //! not hash to the manifest (corrupt), is never used: it is removed and rebuilt. Entries
 //! are written to a temporary folder and renamed into place.
 
-use crate::bake::BakedEnvironment;
+use crate::reading::BakedEnvironment;
 use crate::error::{Error, Result};
 use crate::product::{Product, Shape};
 use crate::texture::{Cube, Lut};
@@ -21,7 +21,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// Version of the entry format (part of every key).
-pub const FORMAT: &str = "splitsum-cache-4";
+pub const FORMAT: &str = "splitsum-cache-5";
 
 /// The cache folder: `$SPLITSUM_CACHE`, else `$XDG_CACHE_HOME/splitsum`, else
 /// `~/.cache/splitsum`, else `.splitsum-cache`.
@@ -65,11 +65,11 @@ struct Manifest {
 }
 
 /// Whether `name` is a file [`Cache::put`] writes: the only names the cache removes
-/// (`manifest.json`, and `Product::cache_file` of each product). Native systems only: a
+/// (`manifest.json`, `Product::cache_file` of each product, and the excess list's file). Native systems only: a
 /// browser has no cache folder.
 #[cfg(not(target_arch = "wasm32"))]
 fn entry_file(name: &str) -> bool {
-    name == "manifest.json" || Product::ALL.iter().any(|p| p.cache_file() == name)
+    name == "manifest.json" || name == EXCESS_FILE || Product::ALL.iter().any(|p| p.cache_file() == name)
 }
 
 /// The largest entry manifest read (a real one is under a kilobyte).
@@ -149,6 +149,8 @@ pub enum Rejection {
     NotACube(&'static str),
     /// A file that does not hold the table its name says.
     NotATable(&'static str),
+    /// A file that does not hold an excess list of at most `split::TEXELS` entries.
+    NotAList(&'static str),
 }
 
 impl std::fmt::Display for Rejection {
@@ -165,6 +167,7 @@ impl std::fmt::Display for Rejection {
             Rejection::Changed(name) => write!(f, "{name} changed while it was read"),
             Rejection::NotACube(name) => write!(f, "{name} does not hold a cube"),
             Rejection::NotATable(name) => write!(f, "{name} does not hold a table"),
+            Rejection::NotAList(name) => write!(f, "{name} does not hold an excess list"),
         }
     }
 }
@@ -193,6 +196,17 @@ fn cube_bytes(c: &Cube) -> Vec<u8> {
     out.extend_from_slice(&c.layout.levels.to_le_bytes());
     out.extend_from_slice(bytemuck::cast_slice(&c.texels));
     out
+}
+
+/// The excess list's file in an entry (`BakedEnvironment::excess`), where it has one.
+const EXCESS_FILE: &str = "excess.bin";
+
+/// The excess list `bytes` hold (raw `Vec4`s, `bright::ENTRY` an entry), if they hold one
+/// of at most `split::TEXELS` entries.
+fn list_from(bytes: &[u8]) -> Option<Vec<Vec4>> {
+    let entry = 16 * splitsum_shaders::bright::ENTRY as usize;
+    let fits = !bytes.is_empty() && bytes.len().is_multiple_of(entry) && bytes.len() / entry <= crate::backend::split::TEXELS as usize;
+    fits.then(|| bytemuck::pod_collect_to_vec::<u8, Vec4>(bytes))
 }
 
 fn cube_from(bytes: &[u8]) -> Option<Cube> {
@@ -290,7 +304,7 @@ impl Cache {
             }
             Ok(bytes)
         };
-        let mut env = BakedEnvironment { cubes: BTreeMap::new(), tables: BTreeMap::new(), mapping: RoughnessMapping::from_u32(m.mapping) };
+        let mut env = BakedEnvironment { cubes: BTreeMap::new(), tables: BTreeMap::new(), mapping: RoughnessMapping::from_u32(m.mapping), excess: Vec::new() };
         // Every product the entry lists, and only those (a plan leaves some out).
         for p in Product::ALL.into_iter().filter(|p| m.files.contains_key(p.cache_file())) {
             let name = p.cache_file();
@@ -306,6 +320,9 @@ impl Cache {
         }
         if !env.cubes.contains_key(&Product::SourceCube) {
             return Err(Rejection::Unlisted(Product::SourceCube.cache_file()));
+        }
+        if m.files.contains_key(EXCESS_FILE) {
+            env.excess = list_from(&file(EXCESS_FILE)?).ok_or(Rejection::NotAList(EXCESS_FILE))?;
         }
         Ok(env)
     }
@@ -329,7 +346,8 @@ impl Cache {
         // The source cube is its level 0 already (`Baked::into_display`).
         let cubes = env.cubes.iter().map(|(p, c)| (p.cache_file(), cube_bytes(c)));
         let tables = env.tables.iter().map(|(p, t)| (p.cache_file(), table_bytes(t)));
-        for (name, bytes) in cubes.chain(tables) {
+        let excess = (!env.excess.is_empty()).then(|| (EXCESS_FILE, bytemuck::cast_slice::<Vec4, u8>(&env.excess).to_vec()));
+        for (name, bytes) in cubes.chain(tables).chain(excess) {
             std::fs::write(tmp.join(name), &bytes).map_err(fail)?;
             files.insert(name.to_string(), FileEntry { bytes: bytes.len() as u64, blake3: blake3::hash(&bytes).to_hex().to_string() });
         }

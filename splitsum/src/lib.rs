@@ -99,6 +99,7 @@ internal_modules! {
     placement;
     preview;
     product;
+    reading;
     settings;
     table;
     textures;

@@ -88,7 +88,7 @@ pub fn source_cube(name: &str, size: u32) -> splitsum::texture::Cube {
 
 /// A small, quick bake of the courtyard for the display tests (32² specular and sheen
 /// cubes with 4 mips at 64 samples, 8² irradiance, 32² table, the sheen tables), on the CPU.
-pub fn small_display_bake() -> splitsum::bake::BakedEnvironment {
+pub fn small_display_bake() -> splitsum::reading::BakedEnvironment {
     let settings = splitsum::settings::Settings {
         size: 32,
         source_size: Some(64),
@@ -103,7 +103,7 @@ pub fn small_display_bake() -> splitsum::bake::BakedEnvironment {
     };
     let env = splitsum::environment::Environment::Equirect(environment("courtyard"));
     let job = settings.resolve(splitsum::InputShape::of(&env), splitsum::Products::DISPLAY.with_sheen(true)).expect("settings");
-    splitsum::bake::bake_job(&Backend::Cpu, &env, &job).expect("cpu bake").into_display(job.mapping)
+    splitsum::reading::for_display(&Backend::Cpu, &env, &job).expect("cpu bake").0
 }
 
 /// A cube with full mips whose level 0 is `f(direction)` at the texel centres.

@@ -17,7 +17,8 @@ mod check;
 mod zip;
 
 use splitsum::backend::Gpu;
-use splitsum::bake::{self, BakedEnvironment};
+use splitsum::bake;
+use splitsum::reading::{self, BakedEnvironment};
 use splitsum::environment::{self, Environment, InputReport};
 use splitsum::estimate::Estimator;
 use splitsum::{Backend, Choice, Products, Settings, Target, output};
@@ -150,15 +151,11 @@ impl Page {
             let start = web_time::Instant::now();
             let gpu = state.borrow().gpu.as_ref().map(|s| s.gpu.clone());
             let baked = match &gpu {
-                Some(g) => {
-                    let made = bake::make(&**g, &mut Estimator::built_in(true), &env, &job).map_err(shown)?;
-                    bake::read_async(g, made, &job).await.map_err(shown)?
-                }
-                None => bake::bake_job(&Backend::Cpu, &env, &job).map_err(shown)?,
+                Some(g) => reading::for_display_async(g, &mut Estimator::built_in(true), &env, &job).await.map_err(shown)?,
+                None => reading::for_display(&Backend::Cpu, &env, &job).map_err(shown)?.0,
             };
             splitsum::progress::report_to(None);
             let seconds = start.elapsed().as_secs_f64();
-            let baked = baked.into_display(job.mapping);
             let scene = gpu.as_ref().map(|g| GpuScene::new(g, &baked));
             let said = format!("{name}: baked {}² specular, {} mips, in {seconds:.1} s", job.size, job.mips);
             state.borrow_mut().loaded = Some(Loaded { name, env, input, baked, scene });

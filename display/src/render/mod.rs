@@ -9,7 +9,7 @@ use crate::model::Model;
 use rayon::prelude::*;
 use splitsum::Product;
 use splitsum::backend::gpu::{Gpu, group_entries, group_layout};
-use splitsum::bake::BakedEnvironment;
+use splitsum::reading::BakedEnvironment;
 use splitsum::error::{Error, Result};
 use splitsum_shaders::choice::Choice;
 use splitsum_shaders::glam::camera::rh;
@@ -261,6 +261,7 @@ pub fn shading_ns_per_pixel(backend: &splitsum::Backend, env: &BakedEnvironment,
 
 /// The CPU reference renderer: `scene::pixel` at every pixel centre, row 0 at the top.
 pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
+    let specular = env.specular_buffer();
     let (w, h) = (frame.width as u32, frame.height as u32);
     let mut out = vec![Vec4::ZERO; (w * h) as usize];
     out.par_chunks_mut(w as usize).enumerate().for_each(|(y, row)| {
@@ -269,7 +270,7 @@ pub fn render_cpu(env: &BakedEnvironment, frame: &Frame) -> Vec<Vec4> {
             *p = scene::pixel(
                 frame,
                 env.cube(Product::SourceCube).level(0),
-                &env.cube(Product::Specular).texels,
+                &specular,
                 &env.cube(Product::Irradiance).texels,
                 &env.table(Product::BrdfTable).texels,
                 &env.cube(Product::Sheen).texels,
@@ -308,7 +309,7 @@ impl GpuScene {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let specular = gpu.upload_bytes("specular", bytemuck::cast_slice(&env.cube(Product::Specular).texels));
+        let specular = gpu.upload_bytes("specular", bytemuck::cast_slice(&env.specular_buffer()));
         let irradiance = gpu.upload_bytes("irradiance", bytemuck::cast_slice(&env.cube(Product::Irradiance).texels));
         let lut = gpu.upload_bytes("brdf lut", bytemuck::cast_slice(&env.table(Product::BrdfTable).texels));
         let source = gpu.upload_bytes("source", bytemuck::cast_slice(env.cube(Product::SourceCube).level(0)));

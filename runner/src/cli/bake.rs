@@ -250,12 +250,12 @@ fn write_scene_bake(out: &files::OutputDir, sb: &crate::prepare::SceneBake, form
     let mut specular_roughness = Vec::new();
     let specular = &job.prefiltered[&Product::Specular];
     if let (true, Some(&first), Some(&last)) = (job.products.has(Product::Specular), specular.levels.first(), specular.levels.last()) {
-        crate::ktx2::write(&dir.join("specular.ktx2"), &sb.env.cube(Product::Specular).levels(first, last), *format)?;
+        crate::ktx2::write(&dir.join("specular.ktx2"), &sb.env.whole_specular(&specular.levels).levels(first, last), *format)?;
         specular_roughness = (first..=last).map(|l| if specular.levels.contains(&l) { Some(specular.roughness_per_mip[l as usize]) } else { None }).collect();
         written.push("specular.ktx2");
     }
     if job.products.has(Product::Irradiance) {
-        crate::ktx2::write(&dir.join("irradiance.ktx2"), sb.env.cube(Product::Irradiance), *format)?;
+        crate::ktx2::write(&dir.join("irradiance.ktx2"), &sb.env.whole_irradiance(), *format)?;
         written.push("irradiance.ktx2");
     }
     if job.products.has(Product::BrdfTable) {

@@ -1,7 +1,6 @@
 //! `runner` with no arguments: the embedded environment on the sphere grid.
 
 use super::*;
-use crate::bake;
 
 /// `runner` with no arguments: bake the embedded environment and show the sphere grid in a
 /// window, or, where there is no display (or no GPU), render it to `splitsum.png`.
@@ -17,7 +16,7 @@ pub(super) fn default_run() -> anyhow::Result<()> {
         }
     };
     let start = Instant::now();
-    let baked = bake::bake_for_display(&backend, &env, &Settings::display(env.native_face_size()))?;
+    let baked = splitsum::reading::bake_for_display(&backend, &env, &Settings::display(env.native_face_size()))?;
     println!("baked {name} on {} in {:.2} s", backend.describe(), start.elapsed().as_secs_f64());
     let look = LookArgs {
         diffuse: DiffuseModel::default(),

@@ -210,7 +210,7 @@ impl DisplayBakeArgs {
 
     /// The display's bake of `env` on `backend` (`render` and `view`): what it adjusts
     /// stated, a bake estimated over an hour refused unless `force`; with its seconds.
-    pub fn bake(&self, env: &environment::Environment, backend: &Backend, force: bool) -> anyhow::Result<(crate::bake::BakedEnvironment, f64)> {
+    pub fn bake(&self, env: &environment::Environment, backend: &Backend, force: bool) -> anyhow::Result<(splitsum::reading::BakedEnvironment, f64)> {
         use crate::bake;
         let job = self.settings(env).resolve(crate::settings::InputShape::of(env), crate::settings::Products::DISPLAY)?;
         for a in job.adjustments() {
@@ -218,7 +218,7 @@ impl DisplayBakeArgs {
         }
         bake::check_duration(&splitsum::estimate::step_seconds(&job, backend.is_gpu()), force)?;
         let start = Instant::now();
-        let baked = bake::bake_job(backend, env, &job)?.into_display(job.mapping);
+        let (baked, _) = splitsum::reading::for_display(backend, env, &job)?;
         Ok((baked, start.elapsed().as_secs_f64()))
     }
 }

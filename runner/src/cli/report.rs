@@ -64,7 +64,7 @@ fn ladder_costs(env: &environment::Environment, backends: &[Backend], quick: boo
     let (size, frame, repeats) = if quick { (64, 64, 1) } else { (128, 256, 3) };
     let mut rows = Vec::new();
     for backend in backends {
-        let baked = crate::bake::bake_for_display(backend, env, &crate::settings::Settings { size, ..crate::settings::Settings::default() })?;
+        let baked = splitsum::reading::bake_for_display(backend, env, &crate::settings::Settings { size, ..crate::settings::Settings::default() })?;
         let device = splitsum_report::measurement::Device::of(backend);
         // The rungs, and the quality mode below mip 1 (`--filtered`) for its cost beside them.
         let filtered =

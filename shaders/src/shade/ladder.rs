@@ -14,7 +14,9 @@ pub const MAX_FETCHES: u32 = 1 << (LADDER_RUNGS - 1);
 
 /// The radiance the specular lobe of material `m` averages, for normal `n` and view `v`:
 /// one fetch of the prefiltered cube along the read direction (the split sum), or with
-/// [`ShadeOptions::fetches`] `K > 1` the shading ladder's estimate over `K` fetches.
+/// [`ShadeOptions::fetches`] `K > 1` the shading ladder's estimate over `K` fetches. Every
+/// fetch reads the cube alone ([`cube_read`]): where the source was split, the residual,
+/// whose excess [`super::excess_lobe_radiance`] adds once, exactly.
 ///
 /// **Why.** The split sum reads radiance prefiltered with the lobe of `n = v = r`: at
 /// grazing views the true lobe is stretched, leans towards the normal and is cut by the
@@ -90,7 +92,7 @@ pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOpti
             }
         };
         if read_it {
-            let value = prefiltered(shape, specular, read, dir, r).truncate();
+            let value = cube_read(shape, specular, read, dir, r).truncate();
             if k == 0 {
                 one = value;
             } else {

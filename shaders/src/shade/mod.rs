@@ -36,6 +36,8 @@
 
 mod ladder;
 pub use ladder::{LADDER_BLEND, LADDER_FULL_BELOW, LADDER_RUNGS, MAX_FETCHES, lobe_radiance};
+mod read_split;
+pub use read_split::excess_lobe_radiance;
 
 use crate::brdf::{alpha_from_roughness, diffuse, fresnel, microfacet, phong, sheen};
 use crate::cubemap::{self, CubeLayout};
@@ -339,10 +341,8 @@ pub struct EnvironmentShape {
     pub irradiance_size: u32,
     /// Width of the BRDF table.
     pub lut_size: u32,
-    /// Face size of the source cube (the sharp sky).
+    /// Face size of the source cube (the sharp sky: its level 0 alone).
     pub source_size: u32,
-    /// Mips of the source cube.
-    pub source_levels: u32,
     /// Mips of the irradiance cube (1: the display reads level 0).
     pub irradiance_levels: u32,
     /// Face size of mip 0 of the sheen cube (a 1×1 stand-in where none was baked).
@@ -353,6 +353,10 @@ pub struct EnvironmentShape {
     pub sheen_mapping: u32,
     /// Width of the sheen tables.
     pub sheen_table_size: u32,
+    /// Entries of the excess list that follow the specular cube's mips in its buffer
+    /// (`crate::excess`: the specular and irradiance cubes were baked from the residual;
+    /// 0: none, the cubes hold the whole environment).
+    pub excess_entries: u32,
 }
 
 /// The direction the prefiltered cube is read along for normal `n`, mirror direction
@@ -394,12 +398,13 @@ pub fn filtered_lookup(specular: &[Vec4], layout: CubeLayout, dir: Vec3, roughne
     crate::prefilter::prefilter_dir(specular, lower, dir, roughness, FIS_SAMPLES, -1.0)
 }
 
-/// The prefiltered radiance along `dir` at `roughness`, as the display reads it: the
+/// The prefiltered cube read along `dir` at `roughness`, as the display reads it: the
 /// trilinear lookup at the mip the roughness maps to (in log luminance between mips with
 /// [`ShadeOptions::LOG_MIP_BLEND`]), or with [`ShadeOptions::FILTERED_SAMPLING`] below
-/// mip 1 the [`filtered_lookup`].
+/// mip 1 the [`filtered_lookup`]. Where the cube was baked from a split source
+/// ([`EnvironmentShape::excess_entries`]) this is the residual's alone.
 #[inline]
-pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: Vec3, roughness: f32) -> Vec4 {
+pub fn cube_read(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: Vec3, roughness: f32) -> Vec4 {
     let layout = CubeLayout::new(shape.specular_size, shape.specular_levels);
     let lod = RoughnessMapping::from_u32(shape.mapping).lod(roughness, shape.specular_levels);
     if flags & ShadeOptions::FILTERED_SAMPLING != 0 && lod > 0.0 && lod < 1.0 && shape.specular_levels > 1 {
@@ -407,6 +412,19 @@ pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: 
     } else {
         cubemap::sample_levels(specular, layout, dir, lod, flags & ShadeOptions::LOG_MIP_BLEND != 0)
     }
+}
+
+/// The prefiltered radiance along `dir` at `roughness`: the [`cube_read`], plus, where the
+/// cube was baked from a split source, the excess list's exact terms at `roughness`
+/// (`crate::excess::prefiltered_excess`).
+#[inline]
+pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: Vec3, roughness: f32) -> Vec4 {
+    let cube = cube_read(shape, specular, flags, dir, roughness);
+    if shape.excess_entries == 0 {
+        return cube;
+    }
+    let base = CubeLayout::new(shape.specular_size, shape.specular_levels).texel_count();
+    cube + crate::excess::prefiltered_excess(specular, base, shape.excess_entries, dir, roughness, Vec3::ZERO)
 }
 
 /// The direction the one fetch reads the prefiltered cube along for normal `n` and view
@@ -461,15 +479,27 @@ pub fn above_horizon(n: Vec3, d: Vec3, roughness: f32) -> Vec3 {
 }
 
 /// Reads the three baked products for material `m` at normal `n` and view `v`, as `opts`
-/// ask (the read direction, the mip blend and the fetches depend on them).
+/// ask (the read direction, the mip blend and the fetches depend on them); where the
+/// source was split, the excess list's share of each (`crate::excess`).
 #[allow(clippy::too_many_arguments)]
 pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3) -> IblSample {
     let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
-    IblSample {
-        prefiltered: lobe_radiance(shape, specular, opts, m, n, v),
-        irradiance: cubemap::sample_bilinear(irradiance, CubeLayout::new(shape.irradiance_size, shape.irradiance_levels), 0, n).truncate(),
-        brdf: lut::sample(table, shape.lut_size, n_dot_v, m.roughness),
+    let brdf = lut::sample(table, shape.lut_size, n_dot_v, m.roughness);
+    let mut irr = cubemap::sample_bilinear(irradiance, CubeLayout::new(shape.irradiance_size, shape.irradiance_levels), 0, n).truncate();
+    if shape.excess_entries > 0 {
+        let base = CubeLayout::new(shape.specular_size, shape.specular_levels).texel_count();
+        irr += crate::excess::irradiance(specular, base, shape.excess_entries, n);
     }
+    IblSample { prefiltered: lobe_radiance(shape, specular, opts, m, n, v) + excess_lobe_radiance(shape, specular, opts, m, n, v, brdf), irradiance: irr, brdf }
+}
+
+/// The Fresnel factor [`ibl`] scales the table's `A` by (`F₀`, its exact meaning), or,
+/// with [`ShadeOptions::ROUGHNESS_FRESNEL`] and for Phong and Blinn–Phong (which have no
+/// table), the roughness-aware ambient Fresnel.
+#[inline]
+pub fn ibl_fresnel(opts: ShadeOptions, f0: Vec3, n_dot_v: f32, roughness: f32) -> Vec3 {
+    let common = opts.flags & ShadeOptions::ROUGHNESS_FRESNEL != 0;
+    if common || opts.specular != SpecularModel::CookTorrance as u32 { fresnel_ambient(opts.fresnel, f0, n_dot_v, roughness) } else { f0 }
 }
 
 /// Outgoing radiance towards `v` from the image-based light.
@@ -478,10 +508,7 @@ pub fn ibl(opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3, s: IblSample) -> 
     let f0 = m.f0();
     let common = opts.flags & ShadeOptions::ROUGHNESS_FRESNEL != 0;
     let cook_torrance = opts.specular == SpecularModel::CookTorrance as u32;
-    // The Fresnel that scales the table's A (F₀ is its exact meaning), or for Phong and
-    // Blinn–Phong, which have no table, the prefiltered light: roughness-aware only where
-    // it is used.
-    let f = if common || !cook_torrance { fresnel_ambient(opts.fresnel, f0, n_dot_v, m.roughness) } else { f0 };
+    let f = ibl_fresnel(opts, f0, n_dot_v, m.roughness);
     let no_metal = 1.0 - m.metallic;
     let diffuse = if opts.diffuse == DiffuseModel::FresnelWeighted as u32 {
         let view = 1.0 - math::pow5(1.0 - 0.5 * n_dot_v);
