@@ -61,22 +61,15 @@ fn excess_terms_match_a_quadrature_of_the_texel() {
     let quadrature = |d: [f64; 3], alpha: f64, norm: f64| -> f64 {
         let a2 = alpha * alpha;
         let dd = |cs: f64| a2 / (std::f64::consts::PI * (cs * cs * (a2 - 1.0) + 1.0).powi(2));
-        let k = 128;
-        let h = 2.0 / (s as f64 * k as f64);
-        let (a0, b0) = (x as f64 * 2.0 / s as f64 - 1.0, y as f64 * 2.0 / s as f64 - 1.0);
-        let mut sum = 0.0;
-        for j in 0..k {
-            for i in 0..k {
-                let (a, bb) = (a0 + (i as f64 + 0.5) * h, b0 + (j as f64 + 0.5) * h);
-                let l = reference::face_dir(face, a, bb);
-                let omega = h * h / (a * a + bb * bb + 1.0).powf(1.5);
-                let dl = reference::dot(d, l);
-                if dl > 0.0 {
-                    let hv = reference::normalize([d[0] + l[0], d[1] + l[1], d[2] + l[2]]);
-                    sum += dd(reference::dot(d, hv)) * dl * omega;
-                }
+        let sum = over_texel((face, x, y), s, 128, |l| {
+            let dl = reference::dot(d, l);
+            if dl > 0.0 {
+                let hv = reference::normalize([d[0] + l[0], d[1] + l[1], d[2] + l[2]]);
+                dd(reference::dot(d, hv)) * dl
+            } else {
+                0.0
             }
-        }
+        });
         sum / norm
     };
     for r in [0.02f32, 0.05, 0.1, 0.2, 0.5, 1.0] {
@@ -132,27 +125,19 @@ fn excess_lit_by_the_brdf_matches_a_quadrature_of_the_texel() {
     let texel = std::f32::consts::FRAC_PI_2 / s as f32;
     let quadrature = |n: [f64; 3], v: [f64; 3], alpha: f64| -> f64 {
         let a2 = alpha * alpha;
-        let k = 128;
-        let h = 2.0 / (s as f64 * k as f64);
-        let (a0, b0) = (x as f64 * 2.0 / s as f64 - 1.0, y as f64 * 2.0 / s as f64 - 1.0);
         let nv = reference::dot(n, v);
-        let mut sum = 0.0;
-        for j in 0..k {
-            for i in 0..k {
-                let (a, bb) = (a0 + (i as f64 + 0.5) * h, b0 + (j as f64 + 0.5) * h);
-                let l = reference::face_dir(face, a, bb);
-                let omega = h * h / (a * a + bb * bb + 1.0).powf(1.5);
-                let nl = reference::dot(n, l);
-                if nl > 0.0 {
-                    let hv = reference::normalize([v[0] + l[0], v[1] + l[1], v[2] + l[2]]);
-                    let nh = reference::dot(n, hv);
-                    let d = a2 / (std::f64::consts::PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
-                    let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
-                    sum += d * vis * nl * omega;
-                }
+        over_texel((face, x, y), s, 128, |l| {
+            let nl = reference::dot(n, l);
+            if nl > 0.0 {
+                let hv = reference::normalize([v[0] + l[0], v[1] + l[1], v[2] + l[2]]);
+                let nh = reference::dot(n, hv);
+                let d = a2 / (std::f64::consts::PI * (nh * nh * (a2 - 1.0) + 1.0).powi(2));
+                let vis = 0.5 / (nl * (nv * nv * (1.0 - a2) + a2).sqrt() + nv * (nl * nl * (1.0 - a2) + a2).sqrt());
+                d * vis * nl
+            } else {
+                0.0
             }
-        }
-        sum
+        })
     };
     for nv in [1.0f32, 0.5, 0.1] {
         for r in [0.05f32, 0.2, 0.6] {
@@ -216,20 +201,8 @@ fn excess_irradiance_matches_the_reference() {
     }
     let bright = [(4u32, 40u32, 23u32), (0, 10, 50), (2, 31, 31)];
     let quadrature = |n: [f64; 3]| -> f64 {
-        let (k, h) = (64, 2.0 / (s as f64 * 64.0));
-        let mut sum = 0.0;
-        for (t, &(face, x, y)) in bright.iter().enumerate() {
-            let e = list[2 * t + 1].x as f64;
-            let (a0, b0) = (x as f64 * 2.0 / s as f64 - 1.0, y as f64 * 2.0 / s as f64 - 1.0);
-            for j in 0..k {
-                for i in 0..k {
-                    let (a, b) = (a0 + (i as f64 + 0.5) * h, b0 + (j as f64 + 0.5) * h);
-                    let l = reference::face_dir(face, a, b);
-                    sum += e * reference::dot(n, l).max(0.0) * h * h / (a * a + b * b + 1.0).powf(1.5) / std::f64::consts::PI;
-                }
-            }
-        }
-        sum
+        let cosine = |l: [f64; 3]| reference::dot(n, l).max(0.0) / std::f64::consts::PI;
+        bright.iter().enumerate().map(|(t, &texel)| list[2 * t + 1].x as f64 * over_texel(texel, s, 64, cosine)).sum()
     };
     let (mut checked, mut worst) = (0, 0.0f64);
     for i in 0..200u32 {
@@ -258,4 +231,20 @@ fn excess_irradiance_matches_the_reference() {
     }
     println!("excess irradiance: worst {:.3} % over {checked} normals", 100.0 * worst);
     assert!(checked > 50, "{checked} normals checked");
+}
+
+/// `∫ f(l) dl` over texel `(face, x, y)` of a level `s` wide, by the midpoint rule on
+/// `k`² sub-patches of its square, each of its exact solid angle's density
+/// `h²/(a² + b² + 1)^{3/2}` at its centre (f64).
+fn over_texel((face, x, y): (u32, u32, u32), s: u32, k: u32, f: impl Fn([f64; 3]) -> f64) -> f64 {
+    let h = 2.0 / (s as f64 * k as f64);
+    let (a0, b0) = (x as f64 * 2.0 / s as f64 - 1.0, y as f64 * 2.0 / s as f64 - 1.0);
+    let mut sum = 0.0;
+    for j in 0..k {
+        for i in 0..k {
+            let (a, b) = (a0 + (i as f64 + 0.5) * h, b0 + (j as f64 + 0.5) * h);
+            sum += f(reference::face_dir(face, a, b)) * h * h / (a * a + b * b + 1.0).powf(1.5);
+        }
+    }
+    sum
 }

@@ -342,10 +342,9 @@ pub fn measure(backend: &Backend, env: &Environment, methods: &[Method], points:
                     IblSample { prefiltered: vec(p.prefiltered[read]), irradiance: vec(p.irradiance), brdf: p.table[correlated] }
                 } else {
                     let brdf = p.table[correlated];
-                    let base = splitsum_shaders::cubemap::CubeLayout::new(shape.specular_size, shape.specular_levels).texel_count();
                     IblSample {
                         prefiltered: vec(p.residual.1[read]) + shade::excess_lobe_radiance(shape, &spec, opts, m, p.n, p.v, brdf),
-                        irradiance: vec(p.residual.0) + splitsum_shaders::excess::irradiance(&spec, base, shape.excess_entries, p.n),
+                        irradiance: vec(p.residual.0) + shade::excess_irradiance(shape, &spec, p.n),
                         brdf,
                     }
                 };

@@ -6,7 +6,7 @@
 //! whole environment ([`BakedEnvironment::whole_specular`]).
 
 use crate::backend::{Backend, Kernels, with_kernels};
-use crate::bake::{Baked, Timing, bake_job, cube_source, empty_cube, empty_table, make, products, read, read_async};
+use crate::bake::{Baked, Made, Timing, bake_job, cube_source, empty_cube, empty_table, make, products, read, read_async};
 use crate::environment::Environment;
 use crate::error::Result;
 use crate::estimate::Estimator;
@@ -14,7 +14,7 @@ use crate::product::Item;
 use crate::settings::{InputShape, Job, Product, Products, Settings};
 use crate::texture::{Cube, Lut};
 use splitsum_shaders::cubemap::{self, CubeLayout};
-use splitsum_shaders::glam::Vec4;
+use splitsum_shaders::glam::{Vec3, Vec4};
 use splitsum_shaders::prefilter::RoughnessMapping;
 use splitsum_shaders::shade::EnvironmentShape;
 use std::collections::BTreeMap;
@@ -98,7 +98,6 @@ impl BakedEnvironment {
     /// (`splitsum_shaders::excess::prefiltered_excess`; at roughness 0 a texel's own
     /// excess, whole).
     pub fn whole_specular(&self, levels: &[u32]) -> std::borrow::Cow<'_, Cube> {
-        use rayon::prelude::*;
         let cube = self.cube(Product::Specular);
         if self.excess.is_empty() {
             return std::borrow::Cow::Borrowed(cube);
@@ -107,14 +106,8 @@ impl BakedEnvironment {
         let entries = self.excess.len() as u32 / splitsum_shaders::bright::ENTRY;
         let mut texels = cube.texels.clone();
         for &m in levels.iter().filter(|&&m| m < layout.levels) {
-            let s = layout.level_size(m);
             let r = self.mapping.roughness(m, layout.levels);
-            let start = layout.level_offset(m) as usize;
-            texels[start..start + (cubemap::FACES * s * s) as usize].par_iter_mut().enumerate().for_each(|(i, t)| {
-                let i = i as u32;
-                let d = cubemap::texel_dir(i / (s * s), i % s, i / s % s, s);
-                *t += splitsum_shaders::excess::prefiltered_excess(&self.excess, 0, entries, d, r, splitsum_shaders::glam::Vec3::ZERO);
-            });
+            add_per_texel(&mut texels, layout, m, |d| splitsum_shaders::excess::prefiltered_excess(&self.excess, 0, entries, d, r, Vec3::ZERO));
         }
         std::borrow::Cow::Owned(Cube { layout, texels })
     }
@@ -122,19 +115,13 @@ impl BakedEnvironment {
     /// The whole irradiance cube, for a file: where it was baked from a split source, each
     /// texel the residual's plus the excess's (`splitsum_shaders::excess::irradiance`).
     pub fn whole_irradiance(&self) -> std::borrow::Cow<'_, Cube> {
-        use rayon::prelude::*;
         let cube = self.cube(Product::Irradiance);
         if self.excess.is_empty() {
             return std::borrow::Cow::Borrowed(cube);
         }
         let entries = self.excess.len() as u32 / splitsum_shaders::bright::ENTRY;
-        let s = cube.layout.size;
         let mut texels = cube.texels.clone();
-        texels[..(cubemap::FACES * s * s) as usize].par_iter_mut().enumerate().for_each(|(i, t)| {
-            let i = i as u32;
-            let d = cubemap::texel_dir(i / (s * s), i % s, i / s % s, s);
-            *t += splitsum_shaders::excess::irradiance(&self.excess, 0, entries, d).extend(0.0);
-        });
+        add_per_texel(&mut texels, cube.layout, 0, |d| splitsum_shaders::excess::irradiance(&self.excess, 0, entries, d).extend(0.0));
         std::borrow::Cow::Owned(Cube { layout: cube.layout, texels })
     }
 
@@ -159,6 +146,16 @@ impl BakedEnvironment {
     }
 }
 
+/// Adds `f(d)` to each texel of level `level` of `texels` (in `layout`), `d` its direction.
+fn add_per_texel(texels: &mut [Vec4], layout: CubeLayout, level: u32, f: impl Fn(Vec3) -> Vec4 + Sync) {
+    use rayon::prelude::*;
+    let s = layout.level_size(level);
+    let start = layout.level_offset(level) as usize;
+    texels[start..start + (cubemap::FACES * s * s) as usize].par_iter_mut().enumerate().for_each(|(i, t)| {
+        *t += f(cubemap::texel_geometry(i as u32, s).truncate());
+    });
+}
+
 /// Bakes what a renderer reads ([`Products::DISPLAY`]) of `env` on `backend`
 /// ([`for_display`]).
 pub fn bake_for_display(backend: &Backend, env: &Environment, settings: &Settings) -> Result<BakedEnvironment> {
@@ -178,19 +175,15 @@ pub fn for_display(backend: &Backend, env: &Environment, job: &Job) -> Result<(B
     let mut excess = Vec::new();
     if reads_split(job) {
         let source = baked.cube(Product::SourceCube).expect("every bake makes the source cube");
-        let size = source.layout.size;
-        let (residual, list) = split_for_reading(source);
         let rest = residual_job(job);
         let mut est = crate::estimate::for_job(backend, &rest)?;
         let made = with_kernels!(backend, k => {
-            let (source, layout) = cube_source(k, k.upload("residual", &full_chain(residual, size))?, size, &rest)?;
-            let mut made = products(k, source, layout, &rest, &mut est, Vec::new())?;
-            // The residual's source cube stays where it was made: nothing reads it.
-            made.take(Product::SourceCube);
-            read(k, made, &rest)
+            let (made, list) = make_residual(k, &mut est, source, &rest)?;
+            Ok((read(k, made, &rest)?, list))
         });
         crate::estimate::keep(backend, est);
-        add_split(&mut baked, made?);
+        let (made, list) = made?;
+        add_split(&mut baked, made);
         excess = list;
     }
     let timings = baked.timings.clone();
@@ -206,12 +199,8 @@ pub async fn for_display_async(g: &crate::backend::Gpu, est: &mut Estimator, env
     let mut excess = Vec::new();
     if reads_split(job) {
         let source = baked.cube(Product::SourceCube).expect("every bake makes the source cube");
-        let size = source.layout.size;
-        let (residual, list) = split_for_reading(source);
         let rest = residual_job(job);
-        let (source, layout) = cube_source(g, g.upload("residual", &full_chain(residual, size))?, size, &rest)?;
-        let mut made = products(g, source, layout, &rest, est, Vec::new())?;
-        made.take(Product::SourceCube);
+        let (made, list) = make_residual(g, est, source, &rest)?;
         add_split(&mut baked, read_async(g, made, &rest).await?);
         excess = list;
     }
@@ -240,10 +229,19 @@ fn residual_job(job: &Job) -> Job {
     Job { products, mirror_faces: false, ..job.clone() }
 }
 
-/// Level-0 faces `size` wide in a buffer of their full mip chain (the mips not built yet).
-fn full_chain(mut level: Vec<Vec4>, size: u32) -> Vec<Vec4> {
-    level.resize(CubeLayout::new(size, CubeLayout::full_chain(size)).texel_count() as usize, Vec4::ZERO);
-    level
+/// The products of `rest` ([`residual_job`]) made on `k` from the residual of `source`
+/// (the baked source cube), left where `k` made them, and the excess list split off it
+/// ([`split_for_reading`]).
+fn make_residual<K: Kernels>(k: &K, est: &mut Estimator, source: &Cube, rest: &Job) -> Result<(Made<K::Texels>, Vec<Vec4>)> {
+    let size = source.layout.size;
+    let (mut residual, list) = split_for_reading(source);
+    // Level 0 in a buffer of its full mip chain, which `cube_source` builds.
+    residual.resize(CubeLayout::new(size, CubeLayout::full_chain(size)).texel_count() as usize, Vec4::ZERO);
+    let (texels, layout) = cube_source(k, k.upload("residual", &residual)?, size, rest)?;
+    let mut made = products(k, texels, layout, rest, est, Vec::new())?;
+    // The residual's source cube stays where it was made: nothing reads it.
+    made.take(Product::SourceCube);
+    Ok((made, list))
 }
 
 /// The residual's products `rest` and their steps' times put into `baked`.

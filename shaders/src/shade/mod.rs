@@ -37,7 +37,7 @@
 mod ladder;
 pub use ladder::{LADDER_BLEND, LADDER_FULL_BELOW, LADDER_RUNGS, MAX_FETCHES, lobe_radiance};
 mod read_split;
-pub use read_split::excess_lobe_radiance;
+pub use read_split::{excess_irradiance, excess_lobe_radiance};
 
 use crate::brdf::{alpha_from_roughness, diffuse, fresnel, microfacet, phong, sheen};
 use crate::cubemap::{self, CubeLayout};
@@ -359,6 +359,14 @@ pub struct EnvironmentShape {
     pub excess_entries: u32,
 }
 
+impl EnvironmentShape {
+    /// Where the excess list starts in the specular buffer: after the cube's mips.
+    #[inline]
+    pub fn excess_start(self) -> u32 {
+        CubeLayout::new(self.specular_size, self.specular_levels).texel_count()
+    }
+}
+
 /// The direction the prefiltered cube is read along for normal `n`, mirror direction
 /// `r` and perceptual `roughness`: `r` itself, or with [`ShadeOptions::DOMINANT_DIRECTION`]
 /// the specular dominant direction of Lagarde & de Rousiers 2014 ("Moving Frostbite to
@@ -423,8 +431,7 @@ pub fn prefiltered(shape: EnvironmentShape, specular: &[Vec4], flags: u32, dir: 
     if shape.excess_entries == 0 {
         return cube;
     }
-    let base = CubeLayout::new(shape.specular_size, shape.specular_levels).texel_count();
-    cube + crate::excess::prefiltered_excess(specular, base, shape.excess_entries, dir, roughness, Vec3::ZERO)
+    cube + crate::excess::prefiltered_excess(specular, shape.excess_start(), shape.excess_entries, dir, roughness, Vec3::ZERO)
 }
 
 /// The direction the one fetch reads the prefiltered cube along for normal `n` and view
@@ -485,12 +492,12 @@ pub fn above_horizon(n: Vec3, d: Vec3, roughness: f32) -> Vec3 {
 pub fn ibl_sample(shape: EnvironmentShape, specular: &[Vec4], irradiance: &[Vec4], table: &[Vec2], opts: ShadeOptions, m: &Material, n: Vec3, v: Vec3) -> IblSample {
     let n_dot_v = math::max(n.dot(v), MIN_N_DOT_V);
     let brdf = lut::sample(table, shape.lut_size, n_dot_v, m.roughness);
-    let mut irr = cubemap::sample_bilinear(irradiance, CubeLayout::new(shape.irradiance_size, shape.irradiance_levels), 0, n).truncate();
-    if shape.excess_entries > 0 {
-        let base = CubeLayout::new(shape.specular_size, shape.specular_levels).texel_count();
-        irr += crate::excess::irradiance(specular, base, shape.excess_entries, n);
+    let irr = cubemap::sample_bilinear(irradiance, CubeLayout::new(shape.irradiance_size, shape.irradiance_levels), 0, n).truncate();
+    IblSample {
+        prefiltered: lobe_radiance(shape, specular, opts, m, n, v) + excess_lobe_radiance(shape, specular, opts, m, n, v, brdf),
+        irradiance: irr + excess_irradiance(shape, specular, n),
+        brdf,
     }
-    IblSample { prefiltered: lobe_radiance(shape, specular, opts, m, n, v) + excess_lobe_radiance(shape, specular, opts, m, n, v, brdf), irradiance: irr, brdf }
 }
 
 /// The Fresnel factor [`ibl`] scales the table's `A` by (`F₀`, its exact meaning), or,

@@ -18,7 +18,7 @@ pub fn excess_lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: Sh
     if count == 0 {
         return Vec3::ZERO;
     }
-    let base = CubeLayout::new(shape.specular_size, shape.specular_levels).texel_count();
+    let base = shape.excess_start();
     if opts.specular != SpecularModel::CookTorrance as u32 {
         let dir = read_direction(opts.flags, n, v, m.roughness);
         return crate::excess::prefiltered_excess(specular, base, count, dir, m.roughness, n).truncate();
@@ -39,4 +39,14 @@ pub fn excess_lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: Sh
     let albedo = ibl_fresnel(opts, f0, n_dot_v, m.roughness) * brdf.x + Vec3::splat(brdf.y);
     let reflected = acc.total().truncate();
     math::finite4((reflected / albedo.max(Vec3::splat(1e-12))).extend(0.0)).truncate()
+}
+
+/// The excess list's irradiance over π at normal `n` (`crate::excess::irradiance`; nothing
+/// without a list), to add to the residual's irradiance read.
+#[inline]
+pub fn excess_irradiance(shape: EnvironmentShape, specular: &[Vec4], n: Vec3) -> Vec3 {
+    if shape.excess_entries == 0 {
+        return Vec3::ZERO;
+    }
+    crate::excess::irradiance(specular, shape.excess_start(), shape.excess_entries, n)
 }
