@@ -33,6 +33,8 @@ pub const MAX_FETCHES: u32 = 1 << (LADDER_RUNGS - 1);
 ///    density of `l` is `p(l) = G₁(v) D(h) / (4 n·v)`, so the weight of a sample for
 ///    `∫ f_s L (n·l) dl` is `f_s (n·l) / p(l) = F(v·h) G₂(v,l) / G₁(v)`. Samples below the
 ///    horizon (`n·l ≤ 0`) weigh nothing: light from under the surface is kept out.
+///    The spiral is drawn in towards the disk's centre by [`spiral_radius2`], so that
+///    the samples' spread and their footprints' spread add up to the lobe's.
 /// 2. Each sample stands for a solid angle `Ω = 1 / (K p(l))`. It reads the prefiltered
 ///    cube at the roughness whose own lobe covers that much sky: the prefilter's lobe
 ///    (`n = v`) has peak density `D(0)/4 = 1/(4πα²)`, so it covers `4πα_f²` and
@@ -76,7 +78,7 @@ pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOpti
         } else {
             let i = k - 1;
             let turn = 0.25 + i as f32 * GOLDEN;
-            let xi = Vec2::new((i as f32 + 0.5) / fetches as f32, turn - math::floor(turn));
+            let xi = Vec2::new(spiral_radius2(i, fetches), turn - math::floor(turn));
             let ht = sampling::sample_vndf_tangent(xi, alpha, vt);
             let h = t * ht.x + b * ht.y + n * ht.z;
             let l = sampling::reflect(view, h);
@@ -106,6 +108,27 @@ pub fn lobe_radiance(shape: EnvironmentShape, specular: &[Vec4], opts: ShadeOpti
         return one;
     }
     one + (sum / weights - one) * s
+}
+
+/// The squared disk radius of the ladder's sample `i` of `k`: the Vogel spiral's
+/// `(i + ½)/k`, drawn in by `1 − 1/k`.
+///
+/// **Why** (the law of total variance): what the ladder averages is the mixture of its
+/// `k` footprints, and a mixture's spread is the spread of its centres plus the mean
+/// spread of each part. Each footprint already covers `1/k` of the lobe (step 2 of
+/// [`lobe_radiance`]), so the centres may spread over only `1 − 1/k` of it, or the
+/// average is wider than the lobe (`k = 2`: one and a half times its spread). On the
+/// sample disk, where the lobe is uniform, the spread is the mean `r²` (½ for the disk,
+/// and for the spiral's `(i + ½)/k`), so each `r²` is scaled by `1 − 1/k`. One fetch
+/// (`k = 1`) collapses onto the centre with a footprint of the whole lobe, at normal
+/// incidence the split sum's own read (the mirror direction at the material's roughness); as
+/// `k` grows the scale goes to 1 and the ladder to filtered importance sampling of the
+/// lobe. Scaling the radius instead, as widths add for Cauchy lobes (`(1 − 1/√k)²` on
+/// `r²`), was worse at every rung on the tuning set (2 fetches 5.3 % against 4.1 %).
+#[inline]
+pub fn spiral_radius2(i: u32, k: u32) -> f32 {
+    let k = k as f32;
+    (i as f32 + 0.5) / k * (1.0 - 1.0 / k)
 }
 
 /// Below this `n·v` the ladder's estimate is used alone; over the next
