@@ -284,8 +284,15 @@ pub fn tap_texel(layout: CubeLayout, level: u32, face: u32, s: u32, x: i32, y: i
 /// equal the unrolled `a + b + c + d` bit for bit.
 #[inline]
 pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3) -> Vec4 {
-    let s = layout.level_size(level);
     let (face, uv) = dir_to_face_uv(d);
+    bilinear_at(texels, layout, level, face, uv)
+}
+
+/// [`sample_bilinear`] at face coordinates `uv` of `face` ([`dir_to_face_uv`]), which a
+/// trilinear lookup finds once for both its levels.
+#[cfg_attr(not(target_arch = "spirv"), inline(always))]
+fn bilinear_at(texels: &[Vec4], layout: CubeLayout, level: u32, face: u32, uv: Vec2) -> Vec4 {
+    let s = layout.level_size(level);
     let sf = s as f32;
     let fx = uv.x * sf - 0.5;
     let fy = uv.y * sf - 0.5;
@@ -295,6 +302,18 @@ pub fn sample_bilinear(texels: &[Vec4], layout: CubeLayout, level: u32, d: Vec3)
     let ty = fy - y0f;
     let x0 = x0f as i32;
     let y0 = y0f as i32;
+    // Natively, the four taps of a lookup inside one face (nearly all of them) are read
+    // as two pairs of neighbours without the wrap: the same weights, sums and order.
+    #[cfg(not(target_arch = "spirv"))]
+    if x0 >= 0 && y0 >= 0 && x0 + 1 < s as i32 && y0 + 1 < s as i32 {
+        let i = layout.index(level, face, x0 as u32, y0 as u32) as usize;
+        let row = s as usize;
+        let quad = &texels[i..i + row + 2];
+        let (w0, w1, w2, w3) = ((1.0 - tx) * (1.0 - ty), tx * (1.0 - ty), (1.0 - tx) * ty, tx * ty);
+        let acc = Vec4::splat(-0.0) + quad[0] * w0 + quad[1] * w1 + quad[row] * w2 + quad[row + 1] * w3;
+        let wsum = -0.0 + w0 + w1 + w2 + w3;
+        return math::finite4(acc * (1.0 / wsum));
+    }
     let mut acc = Vec4::splat(-0.0);
     let mut wsum = -0.0;
     let mut k = 0u32;
@@ -339,9 +358,10 @@ pub fn sample_levels(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32, log
     let l0 = math::floor(l);
     let t = l - l0;
     let m0 = l0 as u32;
-    let a = sample_bilinear(texels, layout, m0, d);
+    let (face, uv) = dir_to_face_uv(d);
+    let a = bilinear_at(texels, layout, m0, face, uv);
     if t > 0.0 && m0 + 1 < layout.levels {
-        let b = sample_bilinear(texels, layout, m0 + 1, d);
+        let b = bilinear_at(texels, layout, m0 + 1, face, uv);
         let linear = a * (1.0 - t) + b * t;
         if log {
             let tiny = 1e-12;
@@ -365,25 +385,29 @@ pub fn downsample_texel(texels: &[Vec4], layout: CubeLayout, level: u32, face: u
     if s == 1 {
         return texels[layout.index(level, face, 0, 0) as usize];
     }
-    // Normalised weights first, so that the sum never exceeds the largest input (no
-    // overflow even at f32::MAX).
-    let mut w = [0.0f32; 4];
-    let mut wsum = 0.0;
-    let mut k = 0;
-    while k < 4 {
-        w[k] = texel_solid_angle(2 * x + (k as u32 & 1), 2 * y + (k as u32 >> 1), s);
-        wsum += w[k];
-        k += 1;
-    }
-    let mut acc = Vec4::ZERO;
-    k = 0;
-    while k < 4 {
-        let cx = 2 * x + (k as u32 & 1);
-        let cy = 2 * y + (k as u32 >> 1);
-        acc += texels[layout.index(level, face, cx, cy) as usize] * (w[k] / wsum);
-        k += 1;
-    }
-    math::finite4(acc)
+    downsample_with(texels, layout, level, face, x, y, downsample_weights(x, y, s))
+}
+
+/// The weights [`downsample_texel`] gives the 2×2 texels of an `s`-wide level under texel
+/// `(x, y)` of the level above, in the order `(2x, 2y)`, `(2x+1, 2y)`, `(2x, 2y+1)`,
+/// `(2x+1, 2y+1)`: each texel's solid angle over the four's sum, normalised first so that
+/// the filtered value never exceeds the largest input (no overflow even at f32::MAX). The
+/// same on every face, so the CPU backend makes them once per level.
+pub fn downsample_weights(x: u32, y: u32, s: u32) -> Vec4 {
+    let w00 = texel_solid_angle(2 * x, 2 * y, s);
+    let w10 = texel_solid_angle(2 * x + 1, 2 * y, s);
+    let w01 = texel_solid_angle(2 * x, 2 * y + 1, s);
+    let w11 = texel_solid_angle(2 * x + 1, 2 * y + 1, s);
+    let wsum = w00 + w10 + w01 + w11;
+    Vec4::new(w00 / wsum, w10 / wsum, w01 / wsum, w11 / wsum)
+}
+
+/// [`downsample_texel`] with its weights given ([`downsample_weights`]).
+#[inline]
+pub fn downsample_with(texels: &[Vec4], layout: CubeLayout, level: u32, face: u32, x: u32, y: u32, w: Vec4) -> Vec4 {
+    let i00 = layout.index(level, face, 2 * x, 2 * y) as usize;
+    let i01 = layout.index(level, face, 2 * x, 2 * y + 1) as usize;
+    math::finite4(Vec4::ZERO + texels[i00] * w.x + texels[i00 + 1] * w.y + texels[i01] * w.z + texels[i01 + 1] * w.w)
 }
 
 /// The unit direction (`xyz`) and solid angle (`w`) of texel `t` of a level with faces

@@ -59,9 +59,26 @@ pub fn sqrt(x: f32) -> f32 {
 }
 
 /// ⌊x⌋ (exact on both backends).
+///
+/// On the GPU, OpExtInst Floor. Natively, `Float::floor` is a call into libm's software
+/// `floorf` (x86-64's baseline has no SSE4.1 `roundss` to inline), which was a tenth of a
+/// CPU bake; here it is truncation through `i32` and one step down for a negative
+/// non-integer, the same value: every `|x| < 2²³` fits an `i32` and truncates exactly,
+/// every larger `|x|` is already an integer, and NaN, ±∞ and ±0 are returned as they are.
 #[inline]
 pub fn floor(x: f32) -> f32 {
-    Float::floor(x)
+    #[cfg(target_arch = "spirv")]
+    {
+        Float::floor(x)
+    }
+    #[cfg(not(target_arch = "spirv"))]
+    {
+        if !(abs(x) < 8_388_608.0) || x == 0.0 {
+            return x;
+        }
+        let t = x as i32 as f32;
+        if t > x { t - 1.0 } else { t }
+    }
 }
 
 /// |x|.

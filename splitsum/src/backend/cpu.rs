@@ -112,11 +112,13 @@ impl Kernels for Cpu {
             let s = layout.level_size(level + 1);
             let dst = &mut below[..(FACES * s * s) as usize];
             let src: &[Vec4] = above;
+            // The weights are the same on every face: made once per level.
+            let weights: Vec<Vec4> = (0..s * s).map(|i| cubemap::downsample_weights(i % s, i / s, 2 * s)).collect();
             dst.par_chunks_mut(s as usize).enumerate().for_each(|(row, texels)| {
                 let face = row as u32 / s;
                 let y = row as u32 % s;
                 for (x, t) in texels.iter_mut().enumerate() {
-                    *t = cubemap::downsample_texel(src, layout, level, face, x as u32, y);
+                    *t = cubemap::downsample_with(src, layout, level, face, x as u32, y, weights[(y * s) as usize + x]);
                 }
             });
         }
