@@ -231,7 +231,9 @@ impl Product {
         /// the native cube lookups lost their libm `floorf` call and their wrap inside a
         /// face, which the calibration kernel's reads gained from about as much as the
         /// specular and more than the source cube and the sheen: CPU source 0.29 (0.28),
-        /// specular 0.71 (0.70), sheen 0.31 (0.31); lavapipe specular 0.68 (0.68).
+        /// sheen 0.31 (0.31); lavapipe specular 0.68 (0.68). The CPU specular's 0.71 (0.70)
+        /// left `runner bake`'s own estimate 20 % high (median of twelve bakes, −17 to +43 %),
+        /// so it is 0.71 · 1.2 = 0.85: then −6 to +3 % on city.exr, −27 to +19 % held out.
         /// Lavapipe's source (0.46, 0.52) and sheen (0.35, 0.56) disagree between the sets
         /// around their earlier values, which are kept. Two runs of the code before, on this
         /// machine, gave the CPU 0.38–0.43, 0.73–0.78 and 0.39–0.46.
@@ -239,7 +241,7 @@ impl Product {
             match (self, gpu) {
                 (Product::SourceCube, false) => 0.29,
                 (Product::SourceCube, true) => 0.41,
-                (Product::Specular, false) => 0.71,
+                (Product::Specular, false) => 0.85,
                 (Product::Specular, true) => 0.68,
                 (Product::Irradiance | Product::Sh9, false) => 0.6,
                 (Product::Irradiance | Product::Sh9, true) => 0.67,
