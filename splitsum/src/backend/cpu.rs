@@ -113,7 +113,8 @@ impl Kernels for Cpu {
             let dst = &mut below[..(FACES * s * s) as usize];
             let src: &[Vec4] = above;
             // The weights are the same on every face: made once per level.
-            let weights: Vec<Vec4> = (0..s * s).map(|i| cubemap::downsample_weights(i % s, i / s, 2 * s)).collect();
+            let src_size = layout.level_size(level);
+            let weights: Vec<Vec4> = (0..s * s).map(|i| cubemap::downsample_weights(i % s, i / s, src_size)).collect();
             dst.par_chunks_mut(s as usize).enumerate().for_each(|(row, texels)| {
                 let face = row as u32 / s;
                 let y = row as u32 % s;
