@@ -148,7 +148,7 @@ fn exact_sums_of_rough_mips_match_the_brute_force_reference() {
         let level = (0..city.layout.levels).find(|&l| city.layout.level_size(l) == prefilter::exact_source_size(prefilter::Lobe::Ggx, rough, 64)).unwrap();
         let mut worst = 0.0f64;
         for n in probe_dirs() {
-            let got = prefilter::exact_dir(prefilter::Lobe::Ggx, &city.texels, city.layout, level, n, rough);
+            let got = prefilter::exact_dir(prefilter::Lobe::Ggx, &city.texels, city.layout, level, splitsum_shaders::cubemap::INLINE_GEOMETRY, n, rough);
             let want = reference::prefilter(&texels, [n.x as f64, n.y as f64, n.z as f64], rough as f64);
             let lum = |c: [f64; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
             worst = worst.max((lum([got.x as f64, got.y as f64, got.z as f64]) - lum(want)).abs() / lum(want));

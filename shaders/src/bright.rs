@@ -38,6 +38,22 @@
 //! ([`traced_texel`]): mip 1 of a 256² cube (128²) takes a quarter of its samples, and the
 //! sunny sky of `tests/sheen.rs` kept its 0.46 % mean there.
 //!
+//! **The density, tabulated.** Every texel of a split level adds every entry, and the
+//! density's power, `(1 − n·l)^(1/(2α))`, was most of that cost (on the CPU, at mip 1, more
+//! than the residual's samples). The density depends on `u = n·l` alone, one function per
+//! level, so a level reads it from a table of its values at `u = i/N`, `N` =
+//! [`DENSITY_STEPS`] ([`density_table_entry`], made once per level from
+//! `sheen::charlie_light_pdf` itself), interpolated linearly ([`excess_density`]). The
+//! table follows the entries in a traced level's buffer ([`traced_texel`]) and precedes
+//! them in the list of a level summed at its own texels ([`accumulate`], [`list_start`]).
+//! It is off by at most `h²/8·max|pdf''|` (`h = 1/N`), about `1.05·10⁻⁸·k²` of the
+//! density's peak for `k = 1/(2α)` above 2, so it is read only where `k ≤ 32` (sheen
+//! roughness 0.125 and up: at most 1.1·10⁻⁵ of the peak; 1.6·10⁻⁶ at 0.2, the default
+//! mip 1) and `u ≤ 63/64`; nearer the normal, where `(1 − u)^k` has an unbounded second
+//! derivative for `k < 2` (and the density is small), and at sharper levels, the density
+//! is computed. `shaders/tests/sheen.rs` checks the bound against the f64 density. Below
+//! the horizon the density is exactly 0.
+//!
 //! **The ring** (sheen roughness 0, `α → 0`): the mean of the radiance round the great
 //! circle `n·l = 0`, always traced coarse. Of the excess, each texel is a disc of its
 //! solid angle, `ρ = √(Ω/π)`, which the circle at `u = n·l` crosses along a chord
@@ -79,23 +95,79 @@ pub fn split_texel(c: Vec4, threshold: f32) -> (Vec4, Vec4) {
     }
 }
 
-/// Adds entries `start .. start + count` of the excess list `list` ([`ENTRY`] `Vec4`s each)
-/// to the sums `p` of the sheen mean in direction `n` for width `alpha`, once the
-/// residual's terms are in: `Eⱼ·pdf(n·lⱼ)·Ωⱼ·W` to the sum, `W` the residual's weight sum
-/// (1 to rounding for samples; the lobe's integral over the level for an exact sum),
-/// nothing to the weight, so that the mean is `R̃ + Σⱼ Eⱼ·pdf(n·lⱼ)·Ωⱼ` (see the module
-/// header).
+/// Intervals of the density table over `u = n·l ∈ [0, 1]` (see the module header).
+pub const DENSITY_STEPS: u32 = 8192;
+
+/// Entries of the density table: its intervals up to `u` = 63/64 ([`excess_density`]).
+pub const DENSITY_ENTRIES: u32 = DENSITY_STEPS / 64 * 63;
+
+/// Whether a level of width `alpha` reads its density from a table (see the module
+/// header): `k = 1/(2α) ≤ 32`, where the interpolation is within 1.1·10⁻⁵ of its peak.
+#[inline]
+pub fn tabulates(alpha: f32) -> bool {
+    alpha >= 1.0 / 64.0
+}
+
+/// Entry `i` of the density table for width `alpha`: the density
+/// (`sheen::charlie_light_pdf`) at both ends of interval `i`, `(pdf(i/N), pdf((i + 1)/N),
+/// 0, 0)` with `N` = [`DENSITY_STEPS`], so that a lookup reads one entry.
+#[inline]
+pub fn density_table_entry(i: u32, alpha: f32) -> Vec4 {
+    let h = 1.0 / DENSITY_STEPS as f32;
+    Vec4::new(sheen::charlie_light_pdf(i as f32 * h, alpha), sheen::charlie_light_pdf((i + 1) as f32 * h, alpha), 0.0, 0.0)
+}
+
+/// The density table of a level of width `alpha`: its [`DENSITY_ENTRIES`] entries in
+/// order where it [`tabulates`], else none.
+#[cfg(not(target_arch = "spirv"))]
+pub fn density_table(alpha: f32) -> impl Iterator<Item = Vec4> {
+    let n = if tabulates(alpha) { DENSITY_ENTRIES } else { 0 };
+    (0..n).map(move |i| density_table_entry(i, alpha))
+}
+
+/// The sheen prefilter's density (`sheen::charlie_light_pdf`) at `u = n·l` for width
+/// `alpha`, read from the level's table at index `table` of `buf` where the level
+/// [`tabulates`] and `u ≤ 63/64`, interpolated linearly; computed elsewhere.
+#[inline]
+pub fn excess_density(buf: &[Vec4], table: u32, u: f32, alpha: f32) -> f32 {
+    if tabulates(alpha) && u <= 63.0 / 64.0 {
+        let t = crate::math::saturate(u) * DENSITY_STEPS as f32;
+        let i = crate::math::min(crate::math::floor(t), (DENSITY_ENTRIES - 1) as f32);
+        let e = buf[(table + i as u32) as usize];
+        e.x + (e.y - e.x) * (t - i)
+    } else {
+        sheen::charlie_light_pdf(u, alpha)
+    }
+}
+
+/// Where a level of width `alpha` finds entry 0 of the excess list in the buffer
+/// [`accumulate`] reads: after its density table ([`density_table`]) where it
+/// [`tabulates`], else at the start.
+#[inline]
+pub fn list_start(alpha: f32) -> u32 {
+    if tabulates(alpha) { DENSITY_ENTRIES } else { 0 }
+}
+
+/// Adds entries `start .. start + count` of the excess list ([`ENTRY`] `Vec4`s each, from
+/// [`list_start`] in `list`, after the level's density table if it has one) to the sums `p`
+/// of the sheen mean in direction `n` for width `alpha`, once the residual's terms are in:
+/// `Eⱼ·pdf(n·lⱼ)·Ωⱼ·W` to the sum (the density by [`excess_density`]), `W` the residual's
+/// weight sum (1 to rounding for samples; the lobe's integral over the level for an exact
+/// sum), nothing to the weight, so that the mean is `R̃ + Σⱼ Eⱼ·pdf(n·lⱼ)·Ωⱼ` (see the
+/// module header).
 pub fn accumulate(list: &[Vec4], n: Vec3, alpha: f32, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
     let n = sampling::normalize_or(n, Vec3::Z);
     let total = p.weight.x;
+    let base = list_start(alpha);
     let mut acc = CompensatedSum4::resume(p.sum, p.carry);
     let mut j = start;
     let end = start + count;
     while j < end {
-        let g = list[(ENTRY * j) as usize];
-        let w = sheen::charlie_light_pdf(n.dot(g.truncate()), alpha) * g.w * total;
+        let g = list[(base + ENTRY * j) as usize];
+        let u = n.dot(g.truncate());
+        let w = if u > 0.0 { excess_density(list, 0, u, alpha) * g.w * total } else { 0.0 };
         if w > 0.0 {
-            acc.add(list[(ENTRY * j + 1) as usize] * w);
+            acc.add(list[(base + ENTRY * j + 1) as usize] * w);
         }
         j += 1;
     }
@@ -105,12 +177,14 @@ pub fn accumulate(list: &[Vec4], n: Vec3, alpha: f32, start: u32, count: u32, p:
 
 /// Texel direction `n` of a level traced coarser than its size (see the module header):
 /// the residual's mean, a `size`² one-level cube at the start of `buf`, read bilinearly
-/// along `n`, plus the `count` excess entries that follow it from index `list`, each
-/// exactly: on the ring (`ring`, sheen roughness 0) the chord the circle cuts through the
-/// entry's disc, elsewhere its density `Eⱼ·pdf(n·lⱼ)·Ωⱼ` for width `alpha`, the term
-/// [`accumulate`] adds.
+/// along `n`, plus the `count` excess entries that follow it from index `list`: on the ring
+/// (`ring`, sheen roughness 0) the chord the circle cuts through each entry's disc,
+/// elsewhere its density term `Eⱼ·pdf(n·lⱼ)·Ωⱼ` for width `alpha` (the term [`accumulate`]
+/// adds), the density read from the level's table where it has one ([`excess_density`]),
+/// which follows the entries.
 pub fn traced_texel(buf: &[Vec4], size: u32, list: u32, count: u32, n: Vec3, alpha: f32, ring: bool) -> Vec4 {
     let n = sampling::normalize_or(n, Vec3::Z);
+    let table = list + ENTRY * count;
     let mut acc = CompensatedSum4::new();
     acc.add(crate::cubemap::sample_bilinear(buf, crate::cubemap::CubeLayout::new(size, 1), 0, n));
     let mut j = 0;
@@ -120,8 +194,10 @@ pub fn traced_texel(buf: &[Vec4], size: u32, list: u32, count: u32, n: Vec3, alp
         let w = if ring {
             let rho2 = g.w * (1.0 / crate::math::PI);
             if u * u < rho2 { crate::math::sqrt(rho2 - u * u) * (1.0 / crate::math::PI) } else { 0.0 }
+        } else if u > 0.0 {
+            excess_density(buf, table, u, alpha) * g.w
         } else {
-            sheen::charlie_light_pdf(u, alpha) * g.w
+            0.0
         };
         if w > 0.0 {
             acc.add(buf[(list + ENTRY * j + 1) as usize] * w);

@@ -230,7 +230,7 @@ pub fn prefilter_exact(
 ) {
     if let Some((layout, i, n)) = prefilter_invocation(id, p) {
         let partial = load_partial(accum, i);
-        store_partial(accum, i, prefilter::exact_accumulate(Lobe::from_u32(p.lobe), src, layout, p.exact_level, n, p.roughness, p.start, p.count, partial));
+        store_partial(accum, i, prefilter::exact_accumulate(Lobe::from_u32(p.lobe), src, layout, p.exact_level, cubemap::INLINE_GEOMETRY, n, p.roughness, p.start, p.count, partial));
     }
 }
 
@@ -252,9 +252,10 @@ pub fn prefilter_bright(
 
 /// One texel of a split sheen level traced at the split level's size, the ring (sheen
 /// roughness 0) among them (`bright::traced_texel`): `buf` holds the residual's mean, a
-/// `src_size`² cube, then from index `start` the `count` entries of the excess list, or for
-/// the ring a header per tile (`bright::ring_tile`: the index of its first entry from
-/// `start`, and their count, as the bits of `x` and `y`) and the tiles' entries; written at `dst_offset` on.
+/// `src_size`² cube, then from index `start` the `count` entries of the excess list and the
+/// level's density table, if it has one (`bright::density_table`), or for the ring a header per tile
+/// (`bright::ring_tile`: the index of its first entry from `start`, and their count, as the
+/// bits of `x` and `y`) and the tiles' entries; written at `dst_offset` on.
 #[spirv(compute(threads(8, 8)))]
 pub fn prefilter_traced(
     #[spirv(global_invocation_id)] id: UVec3,

@@ -329,7 +329,7 @@ pub fn prefilter_texel(
     }
     let n = cubemap::texel_dir(face, x, y, dst_size);
     if exact_level != SAMPLED {
-        return exact_dir(lobe, src, layout, exact_level, n, roughness);
+        return exact_dir(lobe, src, layout, exact_level, cubemap::INLINE_GEOMETRY, n, roughness);
     }
     sampled_dir(lobe, src, layout, n, roughness, samples, lod_bias)
 }
@@ -388,16 +388,18 @@ pub fn exact_level(lobe: Lobe, roughness: f32, samples: u32, layout: CubeLayout)
 }
 
 /// Adds texels `start .. start + count` of source level `level` to the exact mean weighted
-/// by `lobe` for direction `n` and `roughness` (see the module header).
+/// by `lobe` for direction `n` and `roughness` (see the module header), the texels'
+/// geometry read from `src[geometry..]` or computed per term (`cubemap::weighted_level_sum`:
+/// the same values either way).
 #[allow(clippy::too_many_arguments)]
-pub fn exact_accumulate(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
+pub fn exact_accumulate(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32, geometry: u32, n: Vec3, roughness: f32, start: u32, count: u32, p: MeanPartial) -> MeanPartial {
     let n = sampling::normalize_or(n, Vec3::Z);
     let alpha = lobe.alpha(roughness);
     // GGX: D ≤ 1/(πα²) and Ω ≤ 4π/6: scaled by α² so no weight exceeds about 1. Charlie:
     // D scaled by its largest value over the hemisphere (`sheen::charlie_light_weight`).
     let scale = alpha * alpha;
     let charlie = lobe == Lobe::Charlie;
-    cubemap::weighted_level_sum(src, layout, level, cubemap::INLINE_GEOMETRY, start, count, p, |l, omega| {
+    cubemap::weighted_level_sum(src, layout, level, geometry, start, count, p, |l, omega| {
         let n_dot_l = n.dot(l);
         if n_dot_l > 0.0 {
             let d = if charlie {
@@ -413,9 +415,10 @@ pub fn exact_accumulate(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32
     })
 }
 
-/// The exact `lobe`-weighted mean over every texel of `level` (see [`exact_accumulate`]),
+/// The exact `lobe`-weighted mean over every texel of `level` (see [`exact_accumulate`],
+/// which reads the geometry as `geometry` says),
 /// chunked as the GPU runs it.
-pub fn exact_dir(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32, n: Vec3, roughness: f32) -> Vec4 {
+pub fn exact_dir(lobe: Lobe, src: &[Vec4], layout: CubeLayout, level: u32, geometry: u32, n: Vec3, roughness: f32) -> Vec4 {
     let s = layout.level_size(level);
-    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| exact_accumulate(lobe, src, layout, level, n, roughness, start, c, p))
+    MeanPartial::chunked(cubemap::FACES * s * s, |start, c, p| exact_accumulate(lobe, src, layout, level, geometry, n, roughness, start, c, p))
 }

@@ -240,3 +240,45 @@ fn ring_tiles_keep_every_chord() {
         }
     }
 }
+
+/// The sheen excess list's density as a traced level reads it (`bright::excess_density`:
+/// a table interpolated linearly up to `u` = 63/64 where `1/(2α) ≤ 32`, computed elsewhere)
+/// against the f64 density `b(b+1)/(2π)·u(1 − u)^(b−1)`, `b = 1 + 1/(2α)`, at 2·10⁵ values
+/// of `u = n·l` and the edges. Bound, relative to the density's peak: the interpolation's
+/// `h²/8·max|pdf''|` over the tabulated range (computed here from the f64 second
+/// derivative; 1.1·10⁻⁵ at most, at sheen roughness 0.125), plus the f32 density's own
+/// error, 2·10⁻⁵ of its value (its power, as `charlie_terms_match_the_f64_reference`
+/// bounds `D`'s). Below the horizon, and for NaN, exactly 0.
+#[test]
+fn tabulated_sheen_density_is_within_its_interpolation_bound() {
+    use splitsum_shaders::bright::{DENSITY_ENTRIES, DENSITY_STEPS, density_table, excess_density, tabulates};
+    use splitsum_shaders::glam::Vec4;
+    for r in [0.1f32, 0.124, 0.125, 0.15, 0.2, 0.3, 0.4, 0.6, 0.8, 1.0] {
+        let alpha = sheen::alpha(r);
+        let k = 0.5 / alpha as f64;
+        let b = 1.0 + k;
+        let c = b * (b + 1.0) / (2.0 * PI);
+        let pdf = |u: f64| if u > 0.0 { c * u * (1.0 - u).max(0.0).powf(k) } else { 0.0 };
+        let d2 = |u: f64| c * (-2.0 * k * (1.0 - u).powf(k - 1.0) + u * k * (k - 1.0) * (1.0 - u).powf(k - 2.0));
+        let grid = 200_000;
+        let peak = (0..=grid).map(|i| pdf(i as f64 / grid as f64)).fold(0.0, f64::max);
+        let table: Vec<Vec4> = density_table(alpha).collect();
+        assert_eq!(table.len() as u32, if tabulates(alpha) { DENSITY_ENTRIES } else { 0 }, "roughness {r}");
+        let h = 1.0 / DENSITY_STEPS as f64;
+        let interpolation = if tabulates(alpha) { (0..=grid).map(|i| 63.0 / 64.0 * i as f64 / grid as f64).map(|u| d2(u).abs()).fold(0.0, f64::max) * h * h / 8.0 / peak } else { 0.0 };
+        assert!(interpolation < 1.1e-5, "roughness {r}: {interpolation:e}");
+        let mut worst = 0.0f64;
+        let us = (0..grid).map(|i| (i as f64 + 0.37) / grid as f64).chain([0.0, 1e-30, 63.0 / 64.0, 63.0 / 64.0 + 1e-7, 1.0 - 1e-7, 1.0]);
+        for u in us {
+            let got = excess_density(&table, 0, u as f32, alpha) as f64;
+            let want = pdf(u as f32 as f64);
+            let err = (got - want).abs() / peak;
+            assert!(err <= interpolation + 2e-5 * want / peak + 1e-9, "roughness {r}, u {u}: {got:e} against {want:e} ({err:e} of the peak)");
+            worst = worst.max(err);
+        }
+        println!("sheen roughness {r}: tabulated {}, worst {worst:.2e} of the peak (bound {interpolation:.2e} + the f32 density's)", tabulates(alpha));
+        for u in [-1.0f32, -0.0, f32::NAN, f32::NEG_INFINITY] {
+            assert_eq!(excess_density(&table, 0, u, alpha), 0.0, "roughness {r}, u {u}");
+        }
+    }
+}

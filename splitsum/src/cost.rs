@@ -175,7 +175,7 @@ pub fn product_bytes(job: &Job) -> u64 {
 /// about 140 per GGX sample (the half vector ≈ 50, the lookup ≈ 70, the compensated sum
 /// ≈ 20; a Charlie sample ≈ 330, its three Newton steps ≈ 190 in place of the half vector's
 /// 50), 40 per term of a split source's excess list (a dot product, a power, a compensated
-/// sum), 80 per equirect area sample, 90 per term of an exact specular sum (texel
+/// sum; 20 where the level reads the power from its density table), 80 per equirect area sample, 90 per term of an exact specular sum (texel
 /// direction, solid angle, weight, compensated sum), 31 per irradiance term (its direction
 /// and solid angle read from a table: weight 7, compensated sums 24), 130 per SH9 texel. Bytes are the texels read and written (16 each).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
@@ -261,10 +261,13 @@ pub fn work(p: Product, job: &Job) -> Work {
                     w.flops += 60.0 * tiles * crate::backend::split::TEXELS as f64;
                 }
                 if splitsum_shaders::bright::splits(lobe, cube.roughness_per_mip[m], source.size) {
-                    // The excess list: at most `split::TEXELS` terms a texel, two texels each.
+                    // The excess list: at most `split::TEXELS` terms a texel, two texels each,
+                    // and where the level has a density table a third, its entry, in place of
+                    // the power.
                     let terms = texels * crate::backend::split::TEXELS as f64;
-                    w.summed_reads += 2.0 * terms;
-                    w.flops += 40.0 * terms;
+                    let tabulated = splitsum_shaders::bright::tabulates(lobe.alpha(r));
+                    w.summed_reads += if tabulated { 3.0 } else { 2.0 } * terms;
+                    w.flops += if tabulated { 20.0 } else { 40.0 } * terms;
                 }
                 w.bytes += 16.0 * texels;
             }

@@ -66,6 +66,18 @@ pub fn equirect_pyramid(env: &Equirect) -> Vec<Vec4> {
     pyramid
 }
 
+/// Level `level` of the cube `src` alone, as a one-level cube, followed by its geometry table
+/// (`cubemap::level_geometry`, as the GPU backend places it for the irradiance): what an
+/// exact sum reads in place of computing two triangles' solid angles per term, with the
+/// same values bit for bit. Returns the cube, its layout and where the table starts.
+fn level_with_geometry(src: &[Vec4], layout: CubeLayout, level: u32) -> (Vec<Vec4>, CubeLayout, u32) {
+    let s = layout.level_size(level);
+    let n = FACES * s * s;
+    let start = layout.level_offset(level) as usize;
+    let input = src[start..start + n as usize].iter().copied().chain(cubemap::level_geometry(s)).collect();
+    (input, CubeLayout::new(s, 1), n)
+}
+
 impl Cpu {
     /// The `size`² sheen tables, `(Charlie table, sheen albedo, 0, 0)` per texel
     /// (`lut::sheen_texel`): constants, made on the CPU only (`crate::table`).
@@ -146,13 +158,11 @@ impl Kernels for Cpu {
                 let residual_level = split.level_of(src_layout, e);
                 let terms = split.terms(e, residual_level, n);
                 let alpha = job.lobe.alpha(r);
+                let exact = if e == prefilter::SAMPLED { None } else { Some(level_with_geometry(&split.residual, split.layout, residual_level)) };
                 let residual = |d| {
-                    MeanPartial::default().then_chunked(terms, |start, c, p| {
-                        if e == prefilter::SAMPLED {
-                            prefilter::accumulate_samples(job.lobe, &split.residual, split.layout, d, &table, start, c, p)
-                        } else {
-                            prefilter::exact_accumulate(job.lobe, &split.residual, split.layout, residual_level, d, r, start, c, p)
-                        }
+                    MeanPartial::default().then_chunked(terms, |start, c, p| match &exact {
+                        None => prefilter::accumulate_samples(job.lobe, &split.residual, split.layout, d, &table, start, c, p),
+                        Some((input, one, geometry)) => prefilter::exact_accumulate(job.lobe, input, *one, 0, *geometry, d, r, start, c, p),
                     })
                 };
                 if let Some(ts) = split.traced(job.lobe, r, s, src_layout.size) {
@@ -163,7 +173,13 @@ impl Kernels for Cpu {
                     let ring = r <= 0.0;
                     let tail = if ring { split.ring.as_ref().expect("a job with a ring has its table") } else { &split.list };
                     let start = FACES * ts * ts;
-                    buf.extend_from_slice(tail);
+                    if ring {
+                        buf.extend_from_slice(tail);
+                    } else {
+                        // The entries, then the level's density table (`bright`).
+                        buf.extend_from_slice(&tail[..(bright::ENTRY * split.entries) as usize]);
+                        buf.extend(bright::density_table(alpha));
+                    }
                     fill_level(level, s, &bar, |face, x, y| {
                         let (list, count) = if ring {
                             let h = buf[(start + bright::ring_tile(face, x, y, s)) as usize];
@@ -174,15 +190,21 @@ impl Kernels for Cpu {
                         bright::traced_texel(&buf, ts, list, count, cubemap::texel_dir(face, x, y, s), alpha, ring)
                     });
                 } else {
+                    // The level's density table, then the list (`bright::list_start`).
+                    let list: Vec<Vec4> = bright::density_table(alpha).chain(split.list.iter().copied()).collect();
                     fill_level(level, s, &bar, |face, x, y| {
                         let d = cubemap::texel_dir(face, x, y, s);
-                        residual(d).then_chunked(split.entries, |start, c, p| bright::accumulate(&split.list, d, alpha, start, c, p)).resolve()
+                        residual(d).then_chunked(split.entries, |start, c, p| bright::accumulate(&list, d, alpha, start, c, p)).resolve()
                     });
                 }
             } else if e == prefilter::SAMPLED && !job.lobe.is_mirror(r) && job.lobe.alpha(r) > 0.0 {
                 // The samples depend on no texel: made once for the level.
                 let table: Vec<Vec4> = prefilter::lobe_samples(job.lobe, n, r, src_layout.size, job.lod_bias).collect();
                 fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_dir_samples(job.lobe, src, src_layout, cubemap::texel_dir(face, x, y, s), &table));
+            } else if e != prefilter::SAMPLED && !job.lobe.is_mirror(r) {
+                // An exact sum reads its level's geometry from a table made once.
+                let (input, one, geometry) = level_with_geometry(src, src_layout, e);
+                fill_level(level, s, &bar, |face, x, y| prefilter::exact_dir(job.lobe, &input, one, 0, geometry, cubemap::texel_dir(face, x, y, s), r));
             } else {
                 fill_level(level, s, &bar, |face, x, y| prefilter::prefilter_texel(job.lobe, src, src_layout, face, x, y, s, r, n, job.lod_bias, e));
             }
@@ -194,14 +216,8 @@ impl Kernels for Cpu {
         let layout = CubeLayout::new(size, 1);
         let mut texels = vec![Vec4::ZERO; layout.texel_count() as usize];
         let bar = progress("irradiance", (FACES * size) as u64);
-        // The summed level alone, as a one-level cube, followed by its geometry table (as
-        // the GPU backend does).
-        let s = src_layout.level_size(level);
-        let n = FACES * s * s;
-        let start = src_layout.level_offset(level) as usize;
-        let input: Vec<Vec4> = src[start..start + n as usize].iter().copied().chain(cubemap::level_geometry(s)).collect();
-        let one = CubeLayout::new(s, 1);
-        fill_level(&mut texels, size, &bar, |face, x, y| irradiance::convolve_dir(&input, one, 0, n, cubemap::texel_dir(face, x, y, size)));
+        let (input, one, geometry) = level_with_geometry(src, src_layout, level);
+        fill_level(&mut texels, size, &bar, |face, x, y| irradiance::convolve_dir(&input, one, 0, geometry, cubemap::texel_dir(face, x, y, size)));
             Ok(texels)
     }
 

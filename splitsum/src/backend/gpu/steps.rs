@@ -17,7 +17,7 @@ use splitsum_shaders::glam::Vec4;
 use splitsum_shaders::irradiance::SH9;
 use splitsum_shaders::calibrate::Rate;
 use splitsum_shaders::kernels::{CalibrateParams, DownsampleParams, EquirectParams, IrradianceParams, LutParams, PrefilterParams, ProbeParams, ResolveParams, TableParams};
-use splitsum_shaders::{equirect, lut, prefilter};
+use splitsum_shaders::{bright, equirect, lut, prefilter};
 
 /// Texels on the device: `count` RGBA f32 texels in `buffer`.
 pub struct Texels {
@@ -204,12 +204,19 @@ impl Kernels for Gpu {
                 let terms = split.terms(exact_level, residual_level, samples);
                 if let Some(ts) = split.traced(job.lobe, r, s, src_layout.size) {
                     // The ring reads its tile's entries (`split::ring_table`), any other
-                    // level the whole list.
-                    let tail = if r <= 0.0 { split.ring.as_ref().expect("a job with a ring has its table") } else { &split.list };
+                    // level the whole list and its density table (`bright`), written after it.
+                    let ring = r <= 0.0;
+                    let tail = if ring { split.ring.as_ref().expect("a job with a ring has its table") } else { &split.list };
+                    let (copied, table) = if ring { (tail.count, Vec::new()) } else { (bright::ENTRY * split.entries, bright::density_table(job.lobe.alpha(r)).collect()) };
                     let traced = FACES * ts * ts;
-                    let buf = self.output("sheen traced level", bytes((traced + tail.count) as u64))?;
+                    let buf = self.output("sheen traced level", bytes((traced + copied + table.len() as u32) as u64))?;
                     let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-                    encoder.copy_buffer_to_buffer(&tail.buffer, 0, &buf, bytes(traced as u64), bytes(tail.count as u64));
+                    if copied > 0 {
+                        encoder.copy_buffer_to_buffer(&tail.buffer, 0, &buf, bytes(traced as u64), bytes(copied as u64));
+                    }
+                    if !table.is_empty() {
+                        self.queue.write_buffer(&buf, bytes((traced + copied) as u64), bytemuck::cast_slice(&table));
+                    }
                     self.queue.submit([encoder.finish()]);
                     let sums = self.output("sheen traced sums", 3 * bytes(traced as u64))?;
                     let q = PrefilterParams { dst_size: ts, dst_offset: 0, ..q };
@@ -228,9 +235,18 @@ impl Kernels for Gpu {
                 }
                 // `chunks` runs at least one chunk; an empty list needs none.
                 if split.entries > 0 {
+                    // The level's density table, then the list (`bright::list_start`).
+                    let table: Vec<Vec4> = bright::density_table(job.lobe.alpha(r)).collect();
+                    let list = self.output("sheen excess and table", bytes((table.len() as u32 + split.list.count) as u64))?;
+                    if !table.is_empty() {
+                        self.queue.write_buffer(&list, 0, bytemuck::cast_slice(&table));
+                    }
+                    let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+                    encoder.copy_buffer_to_buffer(&split.list.buffer, 0, &list, bytes(table.len() as u64), bytes(split.list.count as u64));
+                    self.queue.submit([encoder.finish()]);
                     for (start, count) in chunks(split.entries) {
                         let q = PrefilterParams { start, count, ..q };
-                        self.run(&[kernel::PREFILTER_BRIGHT.dispatch(&q, Some(&split.list.buffer), &accum, [s, s, FACES])]);
+                        self.run(&[kernel::PREFILTER_BRIGHT.dispatch(&q, Some(&list), &accum, [s, s, FACES])]);
                     }
                 }
                 self.resolve(&accum, &result.buffer, out.level_offset(m), FACES * s * s);
