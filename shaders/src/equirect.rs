@@ -77,9 +77,26 @@ impl Facing {
 /// Equirect coordinates `(u, v)` ∈ [0, 1]² of direction `d` (need not be unit).
 #[inline]
 pub fn dir_to_uv(d: Vec3) -> Vec2 {
-    let u = 0.5 + math::atan2(d.x, -d.z) * (0.5 * math::FRAC_1_PI);
-    let v = math::atan2(math::sqrt(d.x * d.x + d.z * d.z), d.y) * math::FRAC_1_PI;
-    Vec2::new(u, v)
+    Vec2::new(dir_to_u(d), polar_to_v(axis_distance(d), d.y))
+}
+
+/// The equirect's `u` of direction `d`: its longitude, from its `x` and `z` alone.
+#[inline]
+pub fn dir_to_u(d: Vec3) -> f32 {
+    0.5 + math::atan2(d.x, -d.z) * (0.5 * math::FRAC_1_PI)
+}
+
+/// `√(x² + z²)` of `d`: its distance from the `y` axis.
+#[inline]
+pub fn axis_distance(d: Vec3) -> f32 {
+    math::sqrt(d.x * d.x + d.z * d.z)
+}
+
+/// The equirect's `v` of a direction at distance `rho` from the `y` axis and height `y`:
+/// its polar angle from `+Y`, over π.
+#[inline]
+pub fn polar_to_v(rho: f32, y: f32) -> f32 {
+    math::atan2(rho, y) * math::FRAC_1_PI
 }
 
 /// The unit direction at equirect coordinates `(u, v)`.
@@ -121,15 +138,19 @@ pub fn pyramid_texel(pyramid: &[Vec4], width: u32, height: u32, level: u32, x: u
     pyramid[base as usize] * 0.5 + pyramid[(base + 1) as usize] * 0.5
 }
 
-/// The mean of row `y` of pyramid level `level` over `[a, a + len)` in that level's texel
-/// units (wrapping in `u`), `1 ≤ len ≤ width`: each texel weighs in by its overlap.
-fn row_mean(pyramid: &[Vec4], width: u32, height: u32, level: u32, y: u32, a: f32, len: f32) -> Vec4 {
+/// The means of rows `y0` and `y1` of pyramid level `level` over `[a, a + len)` in that
+/// level's texel units (wrapping in `u`), `1 ≤ len ≤ width`: each texel weighs in by its
+/// overlap, the same weights for both rows, computed once.
+#[allow(clippy::too_many_arguments)]
+fn row_means(pyramid: &[Vec4], width: u32, height: u32, level: u32, y0: u32, y1: u32, a: f32, len: f32) -> (Vec4, Vec4) {
     let end = a + len;
     let k0 = math::floor(a) as i32;
     let k1 = math::floor(end) as i32;
     let w = (width >> level) as i32;
-    let row = pyramid_offset(level, width, height) + y * w as u32;
-    let mut acc = Vec4::ZERO;
+    let base = pyramid_offset(level, width, height);
+    let (row0, row1) = (base + y0 * w as u32, base + y1 * w as u32);
+    let mut acc0 = Vec4::ZERO;
+    let mut acc1 = Vec4::ZERO;
     let mut k = k0;
     while k <= k1 {
         let lo = math::max(k as f32, a);
@@ -145,11 +166,13 @@ fn row_mean(pyramid: &[Vec4], width: u32, height: u32, level: u32, y: u32, a: f3
                 x -= w;
             }
             // Weights normalised as they go: the mean never exceeds the largest texel.
-            acc += pyramid[(row + x as u32) as usize] * ((hi - lo) / len);
+            let weight = (hi - lo) / len;
+            acc0 += pyramid[(row0 + x as u32) as usize] * weight;
+            acc1 += pyramid[(row1 + x as u32) as usize] * weight;
         }
         k += 1;
     }
-    math::finite4(acc)
+    (math::finite4(acc0), math::finite4(acc1))
 }
 
 /// Area lookup at `(u, v)` in the row pyramid of a `width`×`height` image: the mean over a
@@ -171,8 +194,7 @@ pub fn sample_area(pyramid: &[Vec4], width: u32, height: u32, levels: u32, uv: V
     let w = (width >> level) as f32;
     let len = math::clamp(win * scale, 1.0, w);
     let a = uv.x * w - 0.5 * len;
-    let r0 = row_mean(pyramid, width, height, level, y0, a, len);
-    let r1 = row_mean(pyramid, width, height, level, y1, a, len);
+    let (r0, r1) = row_means(pyramid, width, height, level, y0, y1, a, len);
     math::finite4(r0 * (1.0 - ty) + r1 * ty)
 }
 
@@ -228,6 +250,22 @@ pub fn cube_texel(pyramid: &[Vec4], width: u32, height: u32, levels: u32, facing
     let nf = n as f32;
     let spacing = 2.0 / (s * nf);
     let texels_per_radian = width as f32 * (0.5 * math::FRAC_1_PI);
+    // What a point's `x` and `z` alone give: its equirect `u`, its distance from the axis and
+    // its window. On a side face (0, 1, 4, 5) those depend on the point's column alone, so
+    // natively they are computed for the first row of points and read back for the others
+    // (the same values, a third of the point's arithmetic).
+    let column = |p: Vec3| {
+        let d = facing.image_direction(p);
+        // Longitude spanned by one grid step: (spacing/r) / sin θ, sin θ = √(x²+z²)/r
+        // (a turn about +Y keeps √(x²+z²), bit for bit: squares and a sum in either order).
+        let rho = axis_distance(p);
+        let window = if rho > 0.0 { spacing / rho * texels_per_radian } else { width as f32 };
+        Vec3::new(dir_to_u(d), axis_distance(d), window)
+    };
+    #[cfg(not(target_arch = "spirv"))]
+    let mut columns = [Vec3::ZERO; 16];
+    #[cfg(not(target_arch = "spirv"))]
+    let side = face != 2 && face != 3 && n as usize <= columns.len();
     let mut acc = Vec4::ZERO;
     let mut wsum = 0.0;
     let mut j = 0;
@@ -241,10 +279,20 @@ pub fn cube_texel(pyramid: &[Vec4], width: u32, height: u32, levels: u32, facing
             // (1 + a² + b²)^(−3/2) ≤ 1, divided by n² so the weights sum to at most 1 and
             // the weighted sum cannot overflow.
             let w = 1.0 / (r2 * r) / (nf * nf);
-            // Longitude spanned by one grid step: (spacing/r) / sin θ, sin θ = √(x²+z²)/r.
-            let rho = math::sqrt(p.x * p.x + p.z * p.z);
-            let window = if rho > 0.0 { spacing / rho * texels_per_radian } else { width as f32 };
-            acc += sample_area(pyramid, width, height, levels, dir_to_uv(facing.image_direction(p)), window) * w;
+            #[cfg(not(target_arch = "spirv"))]
+            let c = if side && j > 0 {
+                columns[i as usize]
+            } else {
+                let c = column(p);
+                if side {
+                    columns[i as usize] = c;
+                }
+                c
+            };
+            #[cfg(target_arch = "spirv")]
+            let c = column(p);
+            let uv = Vec2::new(c.x, polar_to_v(c.y, p.y));
+            acc += sample_area(pyramid, width, height, levels, uv, c.z) * w;
             wsum += w;
             i += 1;
         }
