@@ -18,6 +18,8 @@ FETCHES = [1, 4, 16]
 # The pixels compared: the sphere's interior, n.v >= 0.15 (at the rim a pixel's footprint
 # spans normals its averaged normal does not stand for).
 MIN_NV = 0.15
+# Every how many pixels `mitsuba_spheres shade` computes the exact integrals (its STRIDE).
+STRIDE = 16
 
 
 def splitsum_dir(u, v):
@@ -133,8 +135,9 @@ def compare(directory, spp, res, figure=None):
         print(text)
 
     rows = []
-    say("| environment | set | r | Mitsuba's noise per pixel | " + " | ".join(f"{k} fetch{'es' if k > 1 else ''}: mean per pixel (sphere's mean)" for k in FETCHES) + " | n·v 0.15–0.7, 1 fetch (signed) |")
-    say("|---|---|---|---|" + "---|" * (len(FETCHES) + 1))
+    exact_rows = []
+    say("| environment | set | r | Mitsuba's noise per pixel | " + " | ".join(f"{k} fetch{'es' if k > 1 else ''}: mean per pixel (sphere's mean)" for k in FETCHES) + " | n·v 0.15–0.7, 1 fetch (signed) | exact, separable masking | exact, glTF masking | 16 fetches against exact glTF |")
+    say("|---|---|---|---|" + "---|" * (len(FETCHES) + 4))
     for line in (directory / "envs.txt").read_text().splitlines():
         slug, which, name = line.split("\t")
         points = np.fromfile(directory / f"{slug}_points.f32", dtype="<f4").reshape(-1, 6)
@@ -155,17 +158,36 @@ def compare(directory, spp, res, figure=None):
                 if k == 1:
                     band = nv <= 0.7
                     signed = (got[band] - truth[band]).mean() / truth[band].mean()
-            say(f"| {name} | {which} | {r} | " + " | ".join(cells) + f" | {100 * signed:+.1f} % |")
+            # The exact integrals at every STRIDE-th pixel (mitsuba_spheres shade): Mitsuba's
+            # separable masking and the glTF BRDF's height-correlated one, each against
+            # Mitsuba; and the 16 fetches against the glTF one.
+            pick = np.arange(len(points))[::STRIDE]
+            sub = truth[pick]
+            exact = {m: luminance(np.fromfile(directory / f"{slug}_r{r:g}_exact_{m}.f32", dtype="<f4").reshape(-1, 3)) for m in ("separable", "correlated")}
+            sixteen = luminance(np.fromfile(directory / f"{slug}_r{r:g}_k16.f32", dtype="<f4").reshape(-1, 3))[pick]
+
+            def against(got, want):
+                return np.mean(np.abs(got - want) / np.maximum(want, 1e-6)), (got.mean() - want.mean()) / want.mean()
+
+            pairs = [against(exact["separable"], sub), against(exact["correlated"], sub), against(sixteen, exact["correlated"])]
+            exact_rows.append((which, r, pairs))
+            more = " | ".join(f"{100 * p:.1f} % ({100 * w:+.1f} %)" for p, w in pairs)
+            say(f"| {name} | {which} | {r} | " + " | ".join(cells) + f" | {100 * signed:+.1f} % | {more} |")
     say()
     for which in ["tuning", "held-out"]:
         for k in FETCHES:
             sel = [row for row in rows if row[0] == which and row[2] == k]
             say(f"- {which}, {k} fetch(es): mean over spheres of the mean per-pixel error {100 * np.mean([s[3] for s in sel]):.1f} % (Mitsuba's noise {100 * np.mean([s[5] for s in sel]):.1f} %), worst sphere {100 * max(s[3] for s in sel):.1f} %; error of the sphere's mean {100 * np.mean([s[4] for s in sel]):.1f} %")
+    for which in ["tuning", "held-out"]:
+        sel = [row for row in exact_rows if row[0] == which]
+        for i, what in enumerate(["the exact integral with Mitsuba's separable masking against Mitsuba", "the exact glTF integral (height-correlated masking) against Mitsuba", "16 fetches against the exact glTF integral"]):
+            say(f"- {which}, {what}: mean per-pixel error {100 * np.mean([s[2][i][0] for s in sel]):.1f} %, worst sphere {100 * max(s[2][i][0] for s in sel):.1f} %; sphere's mean {100 * np.mean([s[2][i][1] for s in sel]):+.1f} % (worst {100 * max((s[2][i][1] for s in sel), key=abs):+.1f} %)")
     if figure:
         head = f"<!-- Written by `bash scripts/mitsuba.sh --figure {figure} {spp} {res}` (scripts/mitsuba_spheres.py); regenerate it, do not edit it. -->\n\n"
         tail = (
             f"\nWhite-metal spheres (F₀ = 1, GGX, α = r²) rendered by Mitsuba 3's path tracer at {spp} samples per pixel, {res}×{res}, "
             "against splitsum's shading of the same pixels (defaults, n·v ≥ 0.15): mean relative luminance error per pixel, the error of the sphere's mean luminance in brackets. "
+            f"The last three columns, at every {STRIDE}th pixel: the exact reflectance integral over the baked source cube (splitsum-reference) with Mitsuba's separable Smith masking, and with the glTF BRDF's height-correlated one, each against Mitsuba (the sphere's mean signed), and splitsum's 16 fetches against the second. "
             f"Measured {datetime.date.today().isoformat()}, {machine()}, commit {commit()}.\n"
         )
         Path(figure).write_text(head + "\n".join(lines) + "\n" + tail)

@@ -29,6 +29,11 @@ pub enum Smith {
     /// `G₂ = 1/(1 + Λ(v) + Λ(l))`, `Λ(θ) = (−1 + √(1 + α² tan²θ))/2` (Heitz 2014, eq. 99;
     /// Walter et al. 2007, eq. 34 for Λ).
     Correlated,
+    /// Separable Smith for GGX, `G₂ = G₁(v)·G₁(l)` with `G₁ = 1/(1 + Λ)` (Heitz 2014,
+    /// eq. 98): Mitsuba 3's `roughconductor` (`MicrofacetDistribution::G` in
+    /// `include/mitsuba/render/microfacet.h`, "Smith's separable shadowing-masking
+    /// approximation"), not the glTF BRDF's.
+    Separable,
 }
 
 impl Smith {
@@ -36,12 +41,16 @@ impl Smith {
     pub fn g(self, n_dot_v: f64, n_dot_l: f64, alpha: f64) -> f64 {
         match self {
             Smith::Schlick => g_schlick(n_dot_v, n_dot_l, alpha / 2.0),
-            Smith::Correlated => {
+            Smith::Correlated | Smith::Separable => {
                 let lambda = |c: f64| {
                     let tan2 = (1.0 - c * c) / (c * c);
                     (-1.0 + (1.0 + alpha * alpha * tan2).sqrt()) / 2.0
                 };
-                1.0 / (1.0 + lambda(n_dot_v) + lambda(n_dot_l))
+                if self == Smith::Correlated {
+                    1.0 / (1.0 + lambda(n_dot_v) + lambda(n_dot_l))
+                } else {
+                    1.0 / ((1.0 + lambda(n_dot_v)) * (1.0 + lambda(n_dot_l)))
+                }
             }
         }
     }

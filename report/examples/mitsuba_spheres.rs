@@ -7,7 +7,12 @@
 //! - `shade DIR`: for every `DIR/<slug>_points.f32` that the script's Mitsuba run wrote
 //!   (per pixel: the normal and the view, six f32), bakes `<slug>.exr` with the defaults
 //!   and writes `DIR/<slug>_r<r>_k<K>.f32`: per pixel the RGB that splitsum's shading gives a
-//!   white metal of roughness `r` with `K` fetches (the one fetch is the default).
+//!   white metal of roughness `r` with `K` fetches (the one fetch is the default), and at
+//!   every [`STRIDE`]-th pixel the exact reflectance integral of the same metal over the
+//!   baked source cube (`splitsum_reference::Environment::shade`), with the glTF BRDF's
+//!   height-correlated masking (`<slug>_r<r>_exact_correlated.f32`) and with Mitsuba's
+//!   separable one (`_exact_separable.f32`): which of the two Mitsuba renders, and how far
+//!   apart they are.
 use splitsum::Product;
 use splitsum::backend::{Backend, BackendKind};
 use splitsum::settings::Settings;
@@ -15,12 +20,16 @@ use splitsum_report::measurement::Set;
 use splitsum_report::sets::{MEMBERS, Source};
 use splitsum_shaders::glam::Vec3;
 use splitsum_shaders::shade::{self, Material, ShadeOptions};
+use rayon::prelude::*;
+use splitsum_reference as reference;
 use std::path::Path;
 
 /// The roughnesses rendered (rough metals, r 0.3–1).
 const ROUGHNESS: [f32; 5] = [0.3, 0.5, 0.65, 0.8, 1.0];
 /// The ladder's rungs compared.
 const FETCHES: [u32; 3] = [1, 4, 16];
+/// Every how many pixels the exact integrals are computed (each a sum over the source cube).
+const STRIDE: usize = 16;
 
 fn slug(name: &str) -> String {
     name.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' }).collect()
@@ -58,6 +67,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let env = splitsum::environment::load(&dir.join(format!("{s}.exr")), false)?.0;
                 let baked = splitsum::reading::bake_for_display(&backend, &env, &Settings::default())?;
                 let raw: Vec<f32> = std::fs::read(&points)?.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]])).collect();
+                let source = baked.cube(Product::SourceCube);
+                let exact = reference::Environment::new(source.level(0), source.layout.size);
                 let shape = baked.shape();
                 let specular = baked.specular_buffer();
                 for &r in &ROUGHNESS {
@@ -90,6 +101,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         }
                         let bytes: Vec<u8> = out.iter().flat_map(|x| x.to_le_bytes()).collect();
                         std::fs::write(dir.join(format!("{s}_r{r}_k{k}.f32")), bytes)?;
+                    }
+                    let picked: Vec<&[f32]> = raw.chunks_exact(6).step_by(STRIDE).collect();
+                    for (smith, name) in [(reference::Smith::Correlated, "correlated"), (reference::Smith::Separable, "separable")] {
+                        let out: Vec<f32> = picked
+                            .par_iter()
+                            .flat_map_iter(|p| {
+                                let (n, v) = ([p[0] as f64, p[1] as f64, p[2] as f64], [p[3] as f64, p[4] as f64, p[5] as f64]);
+                                exact.shade(n, v, [1.0; 3], 1.0, r as f64, smith).map(|c| c as f32)
+                            })
+                            .collect();
+                        let bytes: Vec<u8> = out.iter().flat_map(|x| x.to_le_bytes()).collect();
+                        std::fs::write(dir.join(format!("{s}_r{r}_exact_{name}.f32")), bytes)?;
                     }
                 }
                 eprintln!("shaded {s}");
