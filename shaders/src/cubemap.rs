@@ -353,14 +353,10 @@ pub fn sample_lod_log(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32) ->
 /// each call is a lookup the GPU compiler emits again.
 #[inline]
 pub fn sample_levels(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32, log: bool) -> Vec4 {
-    let max_lod = (layout.levels - 1) as f32;
-    let l = math::clamp(lod, 0.0, max_lod);
-    let l0 = math::floor(l);
-    let t = l - l0;
-    let m0 = l0 as u32;
+    let (m0, t) = lod_levels(lod, layout.levels);
     let (face, uv) = dir_to_face_uv(d);
     let a = bilinear_at(texels, layout, m0, face, uv);
-    if t > 0.0 && m0 + 1 < layout.levels {
+    if t > 0.0 {
         let b = bilinear_at(texels, layout, m0 + 1, face, uv);
         let linear = a * (1.0 - t) + b * t;
         if log {
@@ -376,6 +372,24 @@ pub fn sample_levels(texels: &[Vec4], layout: CubeLayout, d: Vec3, lod: f32, log
     } else {
         a
     }
+}
+
+/// The levels a lookup at `lod` blends on a cube of `levels` levels ([`sample_levels`]):
+/// the lower one, `m0`, and the weight `t` of `m0 + 1`, 0 where `lod` is clamped to the
+/// stored levels or falls on one (then only `m0` is read).
+#[inline]
+pub fn lod_levels(lod: f32, levels: u32) -> (u32, f32) {
+    let l = math::clamp(lod, 0.0, (levels - 1) as f32);
+    let l0 = math::floor(l);
+    let m0 = l0 as u32;
+    (m0, if m0 + 1 < levels { l - l0 } else { 0.0 })
+}
+
+/// Texels a [`sample_levels`] lookup at `lod` reads on a cube of `levels` levels: a
+/// bilinear 2×2 at each level it blends ([`lod_levels`]). For the cost model.
+#[inline]
+pub fn lookup_texels(lod: f32, levels: u32) -> u32 {
+    if lod_levels(lod, levels).1 > 0.0 { 8 } else { 4 }
 }
 
 /// Texel `(x, y)` of `face` in level `level + 1` from the 2×2 texels it covers in

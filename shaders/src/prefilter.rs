@@ -286,6 +286,15 @@ pub fn accumulate_samples(lobe: Lobe, src: &[Vec4], layout: CubeLayout, n: Vec3,
     accumulate_with(src, layout, n, lobe == Lobe::Ggx, table.len() as u32, start, count, p, |i| table[i as usize])
 }
 
+/// Source texels sample `g` ([`Lobe::sample`]) reads in [`accumulate`] on a cube of
+/// `levels` levels: none below the horizon (`add_sample` skips it), else the trilinear
+/// lookup's at the sample's level ([`cubemap::lookup_texels`]). For the cost model, which
+/// counts a level's reads sample by sample.
+#[inline]
+pub fn sample_texels(g: Vec4, levels: u32) -> u32 {
+    if g.z > 0.0 { cubemap::lookup_texels(g.w, levels) } else { 0 }
+}
+
 /// [`prefilter_dir`] from a table of its samples ([`lobe_samples`] of a non-zero roughness):
 /// the same values, without making the samples again for every texel.
 #[cfg(not(target_arch = "spirv"))]

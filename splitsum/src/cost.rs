@@ -5,6 +5,8 @@
 
 use crate::measured::{Knob, Measurement, Method, Part, Quantity};
 use crate::settings::{InputShape, Job, Product, TableMethod};
+use splitsum_shaders::cubemap::CubeLayout;
+use splitsum_shaders::{bright, prefilter};
 use serde::Serialize;
 
 /// Error of each product against its reference, per setting: what the planner chooses
@@ -169,15 +171,21 @@ pub fn product_bytes(job: &Job) -> u64 {
 
 /// The work of one step, by kind: what the cost model of `runner bench` counts.
 ///
-/// Texel reads are counted exactly from the job (a trilinear cube lookup reads 8 texels,
-/// an equirect area sample at least 4, a mip texel 4, a term of an exact sum 1).
+/// Texel reads are counted exactly from the job (a cube lookup reads 8 texels where it
+/// blends two levels, 4 at one, a sample below the horizon none: each level's samples are
+/// counted one by one, `prefilter::sample_texels`; an equirect area sample at least 4, a
+/// mip texel 4, a term of an exact sum 1), but for the sheen ring's chords, which depend on
+/// the sky: their expected count for entries spread over the sphere
+/// (`bright::ring_tile_expected`).
 /// Floating-point operations are estimates, counted by reading the shared functions once:
 /// about 140 per GGX sample (the half vector ≈ 50, the lookup ≈ 70, the compensated sum
 /// ≈ 20; a Charlie sample ≈ 330, its three Newton steps ≈ 190 in place of the half vector's
 /// 50), 40 per term of a split source's excess list (a dot product, a power, a compensated
-/// sum; 20 where the level reads the power from its density table), 80 per equirect area sample, 90 per term of an exact specular sum (texel
-/// direction, solid angle, weight, compensated sum), 31 per irradiance term (its direction
-/// and solid angle read from a table: weight 7, compensated sums 24), 130 per SH9 texel. Bytes are the texels read and written (16 each).
+/// sum; 20 where the level reads the power from its density table), 25 per ring chord, 80
+/// per equirect area sample, 90 per term of an exact GGX sum (texel direction, solid angle,
+/// weight, compensated sum; 140 for Charlie's, whose weight is a power), 31 per irradiance
+/// term (its direction and solid angle read from a table: weight 7, compensated sums 24),
+/// 130 per SH9 texel. Bytes are the texels read and written (16 each).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Work {
     /// Texel reads inside filtered lookups (trilinear cube lookups, equirect area samples,
@@ -191,6 +199,25 @@ pub struct Work {
     pub bytes: f64,
 }
 
+/// The work of one step: a [`Work`] per pass, the passes run one after another (a
+/// prefiltered cube's levels), each as long as its own slowest kind ([`Machine::limit`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct StepWork {
+    /// The passes, in order.
+    pub passes: Vec<Work>,
+}
+
+impl StepWork {
+    /// The work of all passes together.
+    pub fn total(&self) -> Work {
+        let mut t = Work::default();
+        for w in &self.passes {
+            t += *w;
+        }
+        t
+    }
+}
+
 impl std::ops::AddAssign for Work {
     fn add_assign(&mut self, o: Work) {
         self.filtered_reads += o.filtered_reads;
@@ -200,14 +227,15 @@ impl std::ops::AddAssign for Work {
     }
 }
 
-/// The work of the step in `job`, by kind (see [`Work`] for what each kind counts).
+/// The work of the step in `job`, by kind (see [`Work`] for what each kind counts), pass
+/// by pass: a prefiltered cube's split, then each level's own pass and its excess list's.
 /// The BRDF table is a constant (`crate::table`): the defaults' is uploaded (its bytes
 /// only); another is integrated once per process, counted here as
 /// `lut::QUADRATURE_MEAN_EVALUATIONS` (or the samples) of about 60 operations per texel.
-pub fn work(p: Product, job: &Job) -> Work {
+pub fn work(p: Product, job: &Job) -> StepWork {
     let mut w = Work::default();
     if !job.products.has(p) {
-        return w;
+        return StepWork::default();
     }
     let source = job.source_layout();
     let faces = |size: u32| 6.0 * (size as f64).powi(2);
@@ -229,49 +257,89 @@ pub fn work(p: Product, job: &Job) -> Work {
             let lobe = p.lobe().expect("a prefiltered cube has a lobe");
             let layout = job.specular_layout();
             let split = crate::backend::split::split_size_of(lobe, &cube.roughness_per_mip, &cube.levels, source.size);
+            let ring = cube.levels.iter().copied().find(|&l| lobe == splitsum_shaders::prefilter::Lobe::Charlie && cube.roughness_per_mip[l as usize] <= 0.0);
+            let mut passes = Vec::new();
+            if let Some(t) = split {
+                // The split (`split::prefilter`): the split level's luminances and split, the
+                // source's level 0 copied where it is finer (the entries' centroids), the
+                // residual's mips; the ring's table, a cone per tile (four corner
+                // directions, ≈ 100) and a test per tile and entry (≈ 25).
+                let mut w = Work::default();
+                w.summed_reads += 2.0 * faces(t) + if t < source.size { faces(source.size) } else { 0.0 };
+                w.filtered_reads += 4.0 * (CubeLayout::new(t, CubeLayout::full_chain(t)).texel_count() as f64 - faces(t));
+                if let Some(l) = ring {
+                    let tiles = 6.0 * (bright::ring_tiles(layout.level_size(l)) as f64).powi(2);
+                    w.flops += tiles * (100.0 + 25.0 * crate::backend::split::TEXELS as f64);
+                }
+                w.bytes += 16.0 * (w.filtered_reads + w.summed_reads);
+                passes.push(w);
+            }
             for &l in &cube.levels {
-                let texels = faces(layout.level_size(l));
+                // The level's own pass (the source or the residual, sampled or summed
+                // exactly), then where it splits the excess list's: over the level's
+                // texels, or a pass that reads the residual traced at a coarser size.
+                let (mut w, mut excess) = (Work::default(), Work::default());
+                let size = layout.level_size(l);
+                let texels = faces(size);
                 let m = l as usize;
                 let r = cube.roughness_per_mip[m];
-                // A level traced at the split level's size computes the residual's mean
-                // there, then reads it (4 texels) at each of its own texels.
-                let traced = split.and_then(|t| crate::backend::split::traced_size(lobe, r, layout.level_size(l), source.size, t));
+                let traced = split.and_then(|t| crate::backend::split::traced_size(lobe, r, size, source.size, t));
                 let at = traced.map_or(texels, faces);
                 if lobe.is_mirror(r) {
                     w.filtered_reads += texels;
-                } else if cube.exact_levels[m] != splitsum_shaders::prefilter::SAMPLED {
+                } else if cube.exact_levels[m] != prefilter::SAMPLED {
                     let terms = at * faces(source.level_size(cube.exact_levels[m]));
                     w.summed_reads += terms;
-                    w.flops += 90.0 * terms;
+                    w.flops += p.flops_per_exact_term() * terms;
                 } else {
-                    let samples = at * job.samples_per_mip[m] as f64;
-                    w.filtered_reads += 8.0 * samples;
-                    w.flops += p.flops_per_sample() * samples;
+                    // Each sample's lookup reads 8 texels, 4 at a clamped level, none below
+                    // the horizon (`prefilter::sample_texels`), in the residual where the
+                    // level reads it.
+                    let n = job.samples_per_mip[m];
+                    let (read_size, read_levels) = match split.filter(|_| crate::backend::split::uses_split(lobe, r, source.size)) {
+                        Some(t) => (t, CubeLayout::full_chain(t)),
+                        None => (source.size, source.levels),
+                    };
+                    let reads: u32 = prefilter::lobe_samples(lobe, n, r, read_size, job.lod_bias).map(|g| prefilter::sample_texels(g, read_levels)).sum();
+                    w.filtered_reads += at * reads as f64;
+                    w.flops += p.flops_per_sample() * at * n as f64;
                 }
                 if traced.is_some() {
-                    w.filtered_reads += 4.0 * texels;
+                    // Each texel reads the traced level bilinearly.
+                    excess.filtered_reads += 4.0 * texels;
                 }
-                if traced.is_some() && r <= 0.0 {
-                    // The ring's chords: each texel reads its tile's header, and the few
-                    // tiles a sun's great circle crosses its entries (`split::ring_table`),
-                    // which depend on the sky and are not counted; the table itself is built
-                    // on the host, a test per tile and entry.
-                    let tiles = 6.0 * (splitsum_shaders::bright::ring_tiles(layout.level_size(l)) as f64).powi(2);
-                    w.summed_reads += texels;
-                    w.flops += 60.0 * tiles * crate::backend::split::TEXELS as f64;
-                }
-                if splitsum_shaders::bright::splits(lobe, cube.roughness_per_mip[m], source.size) {
+                if let (Some(t), true) = (split, traced.is_some() && r <= 0.0) {
+                    // The ring's chords: each texel reads its tile's header and entries, the
+                    // expected count for entries of the split level's mean solid angle
+                    // (`bright::ring_tile_expected`); a chord term reads its entry and
+                    // excess, ≈ 25 operations (a dot product, a square root, a compensated sum).
+                    let tiles = bright::ring_tiles(size);
+                    let per_tile = (size.min(bright::RING_TILE) as f64).powi(2);
+                    let omega = 4.0 * std::f32::consts::PI / (6.0 * (t as f32).powi(2));
+                    let entries = crate::backend::split::TEXELS;
+                    let chords: f64 = (0..6 * tiles * tiles)
+                        .map(|i| bright::ring_tile_expected(i / (tiles * tiles), i % tiles, i / tiles % tiles, size, entries, omega) as f64)
+                        .sum::<f64>()
+                        * per_tile;
+                    excess.summed_reads += texels + 2.0 * chords;
+                    excess.flops += 25.0 * chords;
+                } else if bright::splits(lobe, r, source.size) {
                     // The excess list: at most `split::TEXELS` terms a texel, two texels each,
                     // and where the level has a density table a third, its entry, in place of
                     // the power.
                     let terms = texels * crate::backend::split::TEXELS as f64;
-                    let tabulated = splitsum_shaders::bright::tabulates(lobe.alpha(r));
-                    w.summed_reads += if tabulated { 3.0 } else { 2.0 } * terms;
-                    w.flops += if tabulated { 20.0 } else { 40.0 } * terms;
+                    let tabulated = bright::tabulates(lobe.alpha(r));
+                    excess.summed_reads += if tabulated { 3.0 } else { 2.0 } * terms;
+                    excess.flops += if tabulated { 20.0 } else { 40.0 } * terms;
                 }
-                w.bytes += 16.0 * texels;
+                w.bytes += 16.0 * (texels + w.filtered_reads + w.summed_reads);
+                passes.push(w);
+                if excess != Work::default() {
+                    excess.bytes += 16.0 * (excess.filtered_reads + excess.summed_reads);
+                    passes.push(excess);
+                }
             }
-            w.bytes += 16.0 * (w.filtered_reads + w.summed_reads);
+            return StepWork { passes };
         }
         Product::Irradiance => {
             // Each term reads the texel and its geometry (`cubemap::level_geometry`).
@@ -300,7 +368,7 @@ pub fn work(p: Product, job: &Job) -> Work {
         Product::SheenTables => w.bytes += 16.0 * (crate::table::SHEEN_TABLE_SIZE as f64).powi(2),
         _ => unreachable!("{p} is a prefiltered cube, matched above"),
     }
-    w
+    StepWork { passes: vec![w] }
 }
 
 /// The bytes the product holds in memory while `job` bakes it: a prefiltered level
@@ -323,7 +391,7 @@ pub fn bytes(p: Product, job: &Job) -> u64 {
 }
 
 /// The work of each step of `job` ([`work`]), in the order of [`Product::ALL`].
-pub fn step_work(job: &Job) -> [(Product, Work); Product::COUNT] {
+pub fn step_work(job: &Job) -> [(Product, StepWork); Product::COUNT] {
     Product::ALL.map(|p| (p, work(p, job)))
 }
 
@@ -340,14 +408,20 @@ pub struct Machine {
 }
 
 impl Machine {
-    /// The least time `w` can take on this machine: its slowest kind of work at the
-    /// measured rate (the kinds are taken to overlap, as a GPU's memory and arithmetic do),
-    /// and which kind that is.
-    pub fn limit(&self, w: &Work) -> (f64, &'static str) {
-        [(w.filtered_reads / self.filtered_reads, "filtered reads"), (w.summed_reads / self.summed_reads, "summed reads"), (w.flops / self.flops, "arithmetic")]
-            .into_iter()
-            .max_by(|a, b| a.0.total_cmp(&b.0))
-            .expect("three kinds")
+    /// The least time a step's work `w` can take on this machine: the sum over its passes
+    /// of each pass's slowest kind of work at the measured rate (within a pass the kinds
+    /// are taken to overlap, as a GPU's memory and arithmetic do), and the kind that bounds
+    /// the most of that time.
+    pub fn limit(&self, w: &StepWork) -> (f64, &'static str) {
+        const KINDS: [&str; 3] = ["filtered reads", "summed reads", "arithmetic"];
+        let mut by_kind = [0.0f64; 3];
+        for p in &w.passes {
+            let times = [p.filtered_reads / self.filtered_reads, p.summed_reads / self.summed_reads, p.flops / self.flops];
+            let k = (0..3).max_by(|&a, &b| times[a].total_cmp(&times[b])).expect("three kinds");
+            by_kind[k] += times[k];
+        }
+        let k = (0..3).max_by(|&a, &b| by_kind[a].total_cmp(&by_kind[b])).expect("three kinds");
+        (by_kind.iter().sum(), KINDS[k])
     }
 }
 
@@ -410,7 +484,6 @@ pub fn process_cpu_seconds() -> Option<f64> {
 pub fn measure_machine(backend: &crate::backend::Backend, how: Calibrating) -> crate::error::Result<Machine> {
     use crate::backend::{Backend, Kernels};
     use splitsum_shaders::calibrate::Rate;
-    use splitsum_shaders::cubemap::CubeLayout;
     use splitsum_shaders::glam::Vec4;
     fn rate<K: Kernels>(k: &K, rate: Rate, how: Calibrating) -> crate::error::Result<f64> {
         let layout = CubeLayout::new(128, CubeLayout::full_chain(128));

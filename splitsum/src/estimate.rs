@@ -6,9 +6,11 @@
 //! summed texel reads, floating-point operations) and the calibration kernel measures what
 //! the device does per second of each kind *now*, under whatever load the machine carries
 //! (`cost::measure_machine`, about 0.1 s before the first bake of a process on 2 CPU
-//! cores, 0.3 s on lavapipe; none for a bake too small to show an estimate). The least time a step can take is its slowest kind of work at those rates (its limit);
-//! a step reaches a share of that limit that depends on its code more than on the device
-//! or the load, so
+//! cores, 0.3 s on lavapipe; none for a bake too small to show an estimate). The least
+//! time a step can take is the sum over its passes (a prefiltered cube's split and levels,
+//! each level's excess list apart) of each pass's slowest kind of work at those rates (its
+//! limit); a step reaches a share of that limit that depends on its code more than on the
+//! device or the load, so
 //!
 //! ```text
 //!     estimate(step) = limit(step) / share(step) · c

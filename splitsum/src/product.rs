@@ -180,6 +180,19 @@ impl Product {
     }
 
     internal! {
+        /// Floating-point operations per term of a prefiltered cube's exact sum, counted as
+        /// [`Product::flops_per_sample`]: about 90 per GGX term (the texel's direction and
+        /// solid angle, the weight, the compensated sum), 140 per Charlie term (its weight a
+        /// power, `math::pow`'s `log2` and `exp2` ≈ 50). For the cost model (`cost::work`).
+        pub fn flops_per_exact_term(self) -> f64 {
+            match self {
+                Product::Sheen => 140.0,
+                _ => 90.0,
+            }
+        }
+    }
+
+    internal! {
         /// The roughness each mip of a prefiltered cube holds, given the specular cube's
         /// (the target's): the sheen cube's is linear whatever the target, as the glTF Sample
         /// Viewer reads it (`getIBLRadianceCharlie`: `lod = sheenRoughness · (u_MipCount − 1)`)
@@ -243,17 +256,26 @@ impl Product {
         /// 512² at 0.19–0.20, forest's khronos levels at 0.63), 0.43 the median of both;
         /// lavapipe 0.30–0.37 and 0.33–0.46, both medians 0.37. The CPU source cube's when its
         /// side faces' points reused their column's values (three runs, and two of each
-        /// held-out configuration): 0.33–0.34 and 0.29–0.39, both medians 0.33.
+        /// held-out configuration): 0.33–0.34 and 0.29–0.39, both medians 0.33. The sheen's
+        /// and lavapipe's source cube's again when the limit became the sum of the passes'
+        /// (`cost::Machine::limit`: a level's own pass and its excess list's apart, the split
+        /// and the ring's chords counted) and a lookup at one level counted 4 reads, not 8
+        /// (December 7; two runs of each configuration): CPU sheen 0.51–0.53 on city.exr,
+        /// 0.37–0.63 held out (studio's 512² 0.42–0.43, forest's khronos levels 0.62–0.63),
+        /// 0.50 the median of all ten; lavapipe sheen 0.48–0.49 and 0.41–0.51, 0.48; lavapipe
+        /// source 0.46–0.47 and 0.41–0.54, both medians 0.47. The specular's moved by less
+        /// than the runs' spread (CPU 0.80–0.82 and 0.73–0.84, lavapipe 0.69–0.73 and
+        /// 0.65–0.74) and are kept.
         pub fn share(self, gpu: bool) -> f64 {
             match (self, gpu) {
                 (Product::SourceCube, false) => 0.33,
-                (Product::SourceCube, true) => 0.41,
+                (Product::SourceCube, true) => 0.47,
                 (Product::Specular, false) => 0.85,
                 (Product::Specular, true) => 0.68,
                 (Product::Irradiance | Product::Sh9, false) => 0.6,
                 (Product::Irradiance | Product::Sh9, true) => 0.67,
-                (Product::Sheen, false) => 0.43,
-                (Product::Sheen, true) => 0.37,
+                (Product::Sheen, false) => 0.50,
+                (Product::Sheen, true) => 0.48,
                 (Product::BrdfTable | Product::SheenTables, _) => 1.0,
             }
         }

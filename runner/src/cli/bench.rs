@@ -119,8 +119,9 @@ pub(super) fn bench(args: BenchArgs, raw: &[std::ffi::OsString]) -> anyhow::Resu
         );
         let work = splitsum::cost::step_work(&job);
         for t in &best {
-            let w = work.iter().find(|(s, _)| *s == t.step).expect("every step").1;
-            let (limit, bound) = machine.limit(&w);
+            let step = &work.iter().find(|(s, _)| *s == t.step).expect("every step").1;
+            let (limit, bound) = machine.limit(step);
+            let w = step.total();
             let fraction = if t.seconds > 0.0 && limit > 0.0 { format!("{:.0} %", 100.0 * limit / t.seconds) } else { "-".into() };
             let (estimate, off) = match t.estimate {
                 Some(e) => (format!("{e:.3}"), if t.seconds > 0.0 { format!("{:+.0} %", 100.0 * (e / t.seconds - 1.0)) } else { "-".into() }),

@@ -175,7 +175,8 @@ pub fn ring_table(list: &[Vec4], entries: u32, size: u32) -> Vec<Vec4> {
         .into_par_iter()
         .map(|i| {
             let (face, ty, tx) = (i / (t * t), i / t % t, i % t);
-            (0..entries).filter(|&j| bright::ring_tile_reached(face, tx, ty, size, list[(bright::ENTRY * j) as usize])).collect()
+            let cone = bright::ring_tile_cone(face, tx, ty, size);
+            (0..entries).filter(|&j| bright::ring_cone_reached(cone, list[(bright::ENTRY * j) as usize])).collect()
         })
         .collect();
     let mut table = Vec::with_capacity(tiles as usize + reached.iter().map(|r| r.len() * bright::ENTRY as usize).sum::<usize>());
