@@ -199,19 +199,22 @@ pub struct Work {
     pub bytes: f64,
 }
 
+pub use crate::product::Pass;
+
 /// The work of one step: a [`Work`] per pass, the passes run one after another (a
-/// prefiltered cube's levels), each as long as its own slowest kind ([`Machine::limit`]).
+/// prefiltered cube's split and levels), each as long as its own slowest kind
+/// ([`Machine::limit`]).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct StepWork {
     /// The passes, in order.
-    pub passes: Vec<Work>,
+    pub passes: Vec<(Pass, Work)>,
 }
 
 impl StepWork {
     /// The work of all passes together.
     pub fn total(&self) -> Work {
         let mut t = Work::default();
-        for w in &self.passes {
+        for (_, w) in &self.passes {
             t += *w;
         }
         t
@@ -272,13 +275,13 @@ pub fn work(p: Product, job: &Job) -> StepWork {
                     w.flops += tiles * (100.0 + 25.0 * crate::backend::split::TEXELS as f64);
                 }
                 w.bytes += 16.0 * (w.filtered_reads + w.summed_reads);
-                passes.push(w);
+                passes.push((Pass::Split, w));
             }
             for &l in &cube.levels {
                 // The level's own pass (the source or the residual, sampled or summed
                 // exactly), then where it splits the excess list's: over the level's
                 // texels, or a pass that reads the residual traced at a coarser size.
-                let (mut w, mut excess) = (Work::default(), Work::default());
+                let (mut w, mut excess, mut excess_pass) = (Work::default(), Work::default(), Pass::Excess);
                 let size = layout.level_size(l);
                 let texels = faces(size);
                 let m = l as usize;
@@ -323,6 +326,7 @@ pub fn work(p: Product, job: &Job) -> StepWork {
                         * per_tile;
                     excess.summed_reads += texels + 2.0 * chords;
                     excess.flops += 25.0 * chords;
+                    excess_pass = Pass::Chords;
                 } else if bright::splits(lobe, r, source.size) {
                     // The excess list: at most `split::TEXELS` terms a texel, two texels each,
                     // and where the level has a density table a third, its entry, in place of
@@ -333,10 +337,10 @@ pub fn work(p: Product, job: &Job) -> StepWork {
                     excess.flops += if tabulated { 20.0 } else { 40.0 } * terms;
                 }
                 w.bytes += 16.0 * (texels + w.filtered_reads + w.summed_reads);
-                passes.push(w);
+                passes.push((Pass::Own, w));
                 if excess != Work::default() {
                     excess.bytes += 16.0 * (excess.filtered_reads + excess.summed_reads);
-                    passes.push(excess);
+                    passes.push((excess_pass, excess));
                 }
             }
             return StepWork { passes };
@@ -368,7 +372,7 @@ pub fn work(p: Product, job: &Job) -> StepWork {
         Product::SheenTables => w.bytes += 16.0 * (crate::table::SHEEN_TABLE_SIZE as f64).powi(2),
         _ => unreachable!("{p} is a prefiltered cube, matched above"),
     }
-    StepWork { passes: vec![w] }
+    StepWork { passes: vec![(Pass::Own, w)] }
 }
 
 /// The bytes the product holds in memory while `job` bakes it: a prefiltered level
@@ -415,13 +419,20 @@ impl Machine {
     pub fn limit(&self, w: &StepWork) -> (f64, &'static str) {
         const KINDS: [&str; 3] = ["filtered reads", "summed reads", "arithmetic"];
         let mut by_kind = [0.0f64; 3];
-        for p in &w.passes {
-            let times = [p.filtered_reads / self.filtered_reads, p.summed_reads / self.summed_reads, p.flops / self.flops];
-            let k = (0..3).max_by(|&a, &b| times[a].total_cmp(&times[b])).expect("three kinds");
-            by_kind[k] += times[k];
+        for (_, p) in &w.passes {
+            let (t, k) = self.pass_limit(p);
+            by_kind[k] += t;
         }
         let k = (0..3).max_by(|&a, &b| by_kind[a].total_cmp(&by_kind[b])).expect("three kinds");
         (by_kind.iter().sum(), KINDS[k])
+    }
+
+    /// The least time one pass's work `p` can take: its slowest kind at the measured rate,
+    /// and that kind's index (filtered reads, summed reads, arithmetic).
+    pub fn pass_limit(&self, p: &Work) -> (f64, usize) {
+        let times = [p.filtered_reads / self.filtered_reads, p.summed_reads / self.summed_reads, p.flops / self.flops];
+        let k = (0..3).max_by(|&a, &b| times[a].total_cmp(&times[b])).expect("three kinds");
+        (times[k], k)
     }
 }
 

@@ -13,7 +13,7 @@
 //! device or the load, so
 //!
 //! ```text
-//!     estimate(step) = limit(step) / share(step) · c
+//!     estimate(step) = Σ over its passes of limit(pass) / share(step, pass) · c
 //! ```
 //!
 //! where the limit is at the rates the device reaches unloaded, divided by the share of the
@@ -112,8 +112,8 @@ impl Estimator {
         let work = step_work(job);
         let mut out = Product::ALL.map(|s| (s, Estimate { seconds: 0.0, within }));
         for (k, (step, w)) in work.iter().enumerate() {
-            let (limit, _) = self.machine.limit(w);
-            out[k] = (*step, Estimate { seconds: limit / step.share(self.gpu) / self.availability * c, within });
+            let seconds: f64 = w.passes.iter().map(|(pass, p)| self.machine.pass_limit(p).0 / step.share(*pass, self.gpu)).sum();
+            out[k] = (*step, Estimate { seconds: seconds / self.availability * c, within });
         }
         out
     }

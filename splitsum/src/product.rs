@@ -266,7 +266,17 @@ impl Product {
         /// source 0.46–0.47 and 0.41–0.54, both medians 0.47. The specular's moved by less
         /// than the runs' spread (CPU 0.80–0.82 and 0.73–0.84, lavapipe 0.69–0.73 and
         /// 0.65–0.74) and are kept.
-        pub fn share(self, gpu: bool) -> f64 {
+        ///
+        /// The CPU's sheen passes apart ([`Pass`]), since its excess list's, ring's and
+        /// split's code reach very different shares of their limits (December 7): fitted by
+        /// least squares, in relative error, to each level's time and the split's (measured
+        /// in a build that timed them) against its passes' limits, over two runs of city.exr
+        /// with `--sheen`: own 0.577, excess list 0.548, ring chords 0.133, split 0.059; held
+        /// out (the four configurations, two runs each) 0.552, 0.537, 0.168, 0.046. With the
+        /// tuning set's, the held-out steps are predicted within −12 to +14 % at `runner
+        /// bench`'s limits, where the one share 0.50 gave −21 to +22 %. Lavapipe's sheen
+        /// steps are within −15 to +4 % of `runner bake`'s estimates with one share.
+        pub fn share(self, pass: Pass, gpu: bool) -> f64 {
             match (self, gpu) {
                 (Product::SourceCube, false) => 0.33,
                 (Product::SourceCube, true) => 0.47,
@@ -274,13 +284,34 @@ impl Product {
                 (Product::Specular, true) => 0.68,
                 (Product::Irradiance | Product::Sh9, false) => 0.6,
                 (Product::Irradiance | Product::Sh9, true) => 0.67,
-                (Product::Sheen, false) => 0.50,
+                (Product::Sheen, false) => match pass {
+                    Pass::Own => 0.58,
+                    Pass::Excess => 0.55,
+                    Pass::Chords => 0.13,
+                    Pass::Split => 0.06,
+                },
                 (Product::Sheen, true) => 0.48,
                 (Product::BrdfTable | Product::SheenTables, _) => 1.0,
             }
         }
     }
 
+}
+
+/// What a pass of a step runs: the share of its limit it reaches depends on its code
+/// (`Product::share`), counted by `cost::work`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum Pass {
+    /// A step's work, or a prefiltered level's own: its lookups or exact sum.
+    #[default]
+    Own,
+    /// A split source's excess list at every texel of a level (`bright::accumulate`), or a
+    /// level read back from its traced residual with the list (`bright::traced_texel`).
+    Excess,
+    /// The sheen ring read back from its traced residual with its tile's chords.
+    Chords,
+    /// The split of a source (`backend::split`), on the host.
+    Split,
 }
 
 impl std::fmt::Display for Product {
