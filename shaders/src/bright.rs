@@ -282,9 +282,10 @@ fn ring_reach(cos_beta: f32, omega: f32) -> Option<f32> {
 /// The expected number of `entries` excess entries of solid angle `omega` whose chords
 /// reach tile `(face, tx, ty)` of a `size`-wide ring output, their directions taken as
 /// uniform on the sphere: then `c·l` is uniform on [−1, 1], so each reaches it with
-/// chance `min(sin(β + γ), 1)` ([`ring_reach`]). For the cost model, which cannot know the
-/// sky's entries before the bake (the tables hold 0.93–1.09 of this on the eight vendored
-/// skies at 256², studio.exr at 512², sunset.exr at 128² and city.exr at 64² and 1024²).
+/// chance `min(sin(β + γ), 1)` ([`ring_tile_reached`]'s reach). For the cost model,
+/// which cannot know the sky's entries before the bake (the tables hold 0.93–1.09 of this
+/// on the eight vendored skies at 256², studio.exr at 512², sunset.exr at 128² and
+/// city.exr at 64² and 1024²).
 pub fn ring_tile_expected(face: u32, tx: u32, ty: u32, size: u32, entries: u32, omega: f32) -> f32 {
     let chance = ring_reach(ring_tile_cone(face, tx, ty, size).w, omega).map_or(1.0, |r| crate::math::min(r, 1.0));
     entries as f32 * chance

@@ -236,9 +236,18 @@ fn processor_threads(backend: &crate::backend::Backend) -> Option<u32> {
     }
 }
 
-/// The share of `threads` processors this process gets now, from 0 to 1: `threads`
-/// threads spin for 40 ms of wall time, each counting the processor time it got (1 on a
-/// quiet machine; 1/3 for two threads beside four busy processes on two cores).
+/// The share of `threads` processors this process gets now, from 0 to 1 (1 on a quiet
+/// machine; 1/3 for two threads beside four busy processes on two cores): `threads`
+/// threads spin for 40 ms of wall time, each counting the processor time it got, while
+/// this thread counts the other processes' runnable tasks every 2 ms: the larger of what
+/// the spinners got and the processors' fair share among them and the `threads`, at the
+/// median count. Over a window this short the scheduler hands out its slices
+/// unevenly: two spinners beside `stress-ng --cpu 2` on two cores got 0.29–0.50 each in
+/// 40 ms, where a bake's steps got 0.46–0.47 of their quiet speed, and on a quiet machine
+/// 0.55–1.0; the count (2 others and 2 threads on 2 processors: 0.5; quiet, 1) does not
+/// vary so. Where
+/// the count is not known, or gives less than the spinners got (in a container
+/// `/proc/stat` may count the host's tasks), the spinners' share.
 pub fn availability(threads: u32) -> f64 {
     #[cfg(all(unix, not(target_arch = "wasm32")))]
     {
@@ -249,7 +258,7 @@ pub fn availability(threads: u32) -> f64 {
             t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
         }
         const WINDOW: std::time::Duration = std::time::Duration::from_millis(40);
-        let got: f64 = std::thread::scope(|s| {
+        let (got, mut counts): (f64, Vec<u32>) = std::thread::scope(|s| {
             let spinners: Vec<_> = (0..threads.max(1))
                 .map(|_| {
                     s.spawn(|| {
@@ -261,15 +270,41 @@ pub fn availability(threads: u32) -> f64 {
                     })
                 })
                 .collect();
-            spinners.into_iter().map(|h| h.join().unwrap_or(1.0)).sum()
+            let mut counts = Vec::new();
+            while spinners.iter().any(|h| !h.is_finished()) {
+                std::thread::sleep(std::time::Duration::from_millis(2));
+                counts.extend(others_runnable());
+            }
+            (spinners.into_iter().map(|h| h.join().unwrap_or(1.0)).sum(), counts)
         });
-        (got / threads.max(1) as f64).clamp(0.02, 1.0)
+        let spun = got / threads.max(1) as f64;
+        counts.sort_unstable();
+        let processors = std::thread::available_parallelism().map_or(1, |n| n.get()) as f64;
+        let fair = counts.get(counts.len() / 2).map_or(0.0, |&n| processors / (n + threads.max(1)) as f64);
+        spun.max(fair).clamp(0.02, 1.0)
     }
     #[cfg(not(all(unix, not(target_arch = "wasm32"))))]
     {
         let _ = threads;
         1.0
     }
+}
+
+/// The tasks of other processes runnable on this machine now: Linux's `procs_running`
+/// (`/proc/stat`) less this process's threads that are runnable (`/proc/self/task`: the
+/// spinners, the reader itself, and any pool thread still spinning before it sleeps,
+/// which under load stays runnable for tens of milliseconds); `None` where either is not
+/// known.
+fn others_runnable() -> Option<u32> {
+    let stat = std::fs::read_to_string("/proc/stat").ok()?;
+    let all: u32 = stat.lines().find_map(|l| l.strip_prefix("procs_running ")).and_then(|n| n.trim().parse().ok())?;
+    let mut own = 0u32;
+    for task in std::fs::read_dir("/proc/self/task").ok()? {
+        let stat = std::fs::read_to_string(task.ok()?.path().join("stat")).ok()?;
+        // The state follows the command's closing parenthesis.
+        own += (stat.rsplit(')').next()?.trim_start().starts_with('R')) as u32;
+    }
+    Some(all.saturating_sub(own))
 }
 
 /// The estimator for `job` on `backend`: [`for_backend`]'s, but without a calibration
