@@ -260,7 +260,7 @@ pub fn work(p: Product, job: &Job) -> StepWork {
             let lobe = p.lobe().expect("a prefiltered cube has a lobe");
             let layout = job.specular_layout();
             let split = crate::backend::split::split_size_of(lobe, &cube.roughness_per_mip, &cube.levels, source.size);
-            let ring = cube.levels.iter().copied().find(|&l| lobe == splitsum_shaders::prefilter::Lobe::Charlie && cube.roughness_per_mip[l as usize] <= 0.0);
+            let ring = cube.levels.iter().copied().find(|&l| crate::backend::split::is_ring(lobe, cube.roughness_per_mip[l as usize]));
             let mut passes = Vec::new();
             if let Some(t) = split {
                 // The split (`split::prefilter`): the split level's luminances and split, the

@@ -100,7 +100,7 @@ pub fn uses_split(lobe: Lobe, roughness: f32, src_size: u32) -> bool {
 }
 
 /// Whether a level of `lobe` for `roughness` is the sheen ring (sheen roughness 0).
-fn is_ring(lobe: Lobe, roughness: f32) -> bool {
+pub fn is_ring(lobe: Lobe, roughness: f32) -> bool {
     lobe == Lobe::Charlie && roughness <= 0.0
 }
 
