@@ -311,18 +311,20 @@ pub fn work(p: Product, job: &Job) -> StepWork {
                     // Each texel reads the traced level bilinearly.
                     excess.filtered_reads += 4.0 * texels;
                 }
-                if let (Some(t), true) = (split, traced.is_some() && r <= 0.0) {
+                if let Some(t) = split.filter(|_| traced.is_some() && crate::backend::split::is_ring(lobe, r)) {
                     // The ring's chords: each texel reads its tile's header and entries, the
                     // expected count for entries of the split level's mean solid angle
                     // (`bright::ring_tile_expected`); a chord term reads its entry and
                     // excess, ≈ 25 operations (a dot product, a square root, a compensated sum).
+                    // The six faces are rotations of one another: one face's sum, six times.
                     let tiles = bright::ring_tiles(size);
                     let per_tile = (size.min(bright::RING_TILE) as f64).powi(2);
                     let omega = 4.0 * std::f32::consts::PI / (6.0 * (t as f32).powi(2));
                     let entries = crate::backend::split::TEXELS;
-                    let chords: f64 = (0..6 * tiles * tiles)
-                        .map(|i| bright::ring_tile_expected(i / (tiles * tiles), i % tiles, i / tiles % tiles, size, entries, omega) as f64)
+                    let chords: f64 = (0..tiles * tiles)
+                        .map(|i| bright::ring_tile_expected(0, i % tiles, i / tiles, size, entries, omega) as f64)
                         .sum::<f64>()
+                        * 6.0
                         * per_tile;
                     excess.summed_reads += texels + 2.0 * chords;
                     excess.flops += 25.0 * chords;

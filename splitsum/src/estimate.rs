@@ -245,9 +245,8 @@ fn processor_threads(backend: &crate::backend::Backend) -> Option<u32> {
 /// unevenly: two spinners beside `stress-ng --cpu 2` on two cores got 0.29–0.50 each in
 /// 40 ms, where a bake's steps got 0.46–0.47 of their quiet speed, and on a quiet machine
 /// 0.55–1.0; the count (2 others and 2 threads on 2 processors: 0.5; quiet, 1) does not
-/// vary so. Where
-/// the count is not known, or gives less than the spinners got (in a container
-/// `/proc/stat` may count the host's tasks), the spinners' share.
+/// vary so. Where the count is not known, or gives less than the spinners got (in a
+/// container `/proc/stat` may count the host's tasks), the spinners' share.
 pub fn availability(threads: u32) -> f64 {
     #[cfg(all(unix, not(target_arch = "wasm32")))]
     {
