@@ -35,7 +35,7 @@
 //! on top, `L_o = sheen + base·(1 − max(c)·E_C)` ([`sheen_ibl`], [`sheen_direct`]).
 
 mod ladder;
-pub use ladder::{LADDER_BLEND, LADDER_FULL_BELOW, LADDER_RUNGS, MAX_FETCHES, lobe_radiance, spiral_radius2};
+pub use ladder::{LADDER_BLEND, LADDER_CROSSOVER, LADDER_RUNGS, MAX_FETCHES, ladder_weight, lobe_radiance, spiral_radius2};
 mod read_split;
 pub use read_split::{excess_irradiance, excess_lobe_radiance};
 
