@@ -1,11 +1,10 @@
 #!/usr/bin/env bash
-# splitsum against Mitsuba 3 (scalar_rgb, from PyPI, in a virtual environment under
-# target/): single white-metal spheres (r 0.3, 0.5, 0.65, 0.8, 1) under every sunny
-# environment of the tuning and the held-out sets (or those named after RES), rendered by
-# Mitsuba's path tracer (one bounce: the exact reflectance integral, estimated), and
-# splitsum's shading of the same pixels at 1, 4 and 16 fetches. Prints the table the README
-# quotes. 22 s on 2 cores for all eight environments at 256 samples, 64² (once Mitsuba is
-# installed and the example built).
+# splitsum against Mitsuba 3 (llvm_ad_rgb, from PyPI, in a virtual environment under
+# target/): single spheres of white metal and of a coloured dielectric (r 0.3, 0.5, 0.65,
+# 0.8, 1) under every sunny environment of the tuning and the held-out sets (or those named
+# after RES), rendered by Mitsuba's path tracer with the glTF BRDF (scripts/mitsuba_gltf.py;
+# one bounce: the exact reflectance integral, estimated), and splitsum's shading of the same
+# pixels at 1, 4 and 16 fetches. Prints the table the guide quotes.
 # With --figure FILE it also writes the table as a generated figure of the guide (`bash
 # scripts/dev.sh figures` writes book/src/figures/mitsuba.md so).
 #   bash scripts/mitsuba.sh [--figure FILE] [SPP] [RES] [ENVIRONMENT...]
@@ -27,6 +26,14 @@ if ! dry && [ ! -x "$VENV/bin/python" ]; then
     python3 -m venv "$VENV"
     "$VENV/bin/pip" install -q "mitsuba==3.9.1" "numpy>=1.26" >&2
 fi
+# The llvm variant compiles through the system's libLLVM, which Dr.Jit 1.5 needs at 16 or
+# newer (LLVM 14 and 15 cannot lower its llvm.maximum on x86: "Cannot select: fmaximum").
+llvm() { ls /usr/lib/*/libLLVM.so.[0-9][0-9]* /usr/lib/*/libLLVM-[0-9][0-9].so 2>/dev/null | grep -E 'LLVM(\.so\.|-)(1[6-9]|[2-9][0-9])' | sort -V | tail -1; }
+if ! dry && [ -z "$(llvm)" ]; then
+    echo "mitsuba.sh: installing libllvm19 (Mitsuba's llvm variant needs LLVM 16 or newer)" >&2
+    if [ "$(id -u)" = 0 ]; then apt-get install -y -qq libllvm19 >&2; else sudo apt-get install -y -qq libllvm19 >&2; fi
+fi
+dry || export DRJIT_LIBLLVM_PATH="$(llvm)"
 OUT=target/mitsuba
 dry || { rm -rf "$OUT" && mkdir -p "$OUT"; }
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp}

@@ -1,18 +1,18 @@
 //! splitsum's side of the comparison with Mitsuba 3 (`scripts/mitsuba.sh`): single spheres
-//! of white metal (F₀ = 1) under the sunny environments of both sets.
+//! of white metal (F₀ = 1) and of a coloured dielectric under the sunny environments of both
+//! sets, which Mitsuba renders with the glTF BRDF (`scripts/mitsuba_gltf.py`).
 //!
 //! - `envs DIR [NAME...]`: writes each sunny environment of the two sets (or those named)
 //!   as `DIR/<slug>.exr` (32-bit float, the radiance splitsum reads), and `DIR/envs.txt`
 //!   (slug, set).
 //! - `shade DIR`: for every `DIR/<slug>_points.f32` that the script's Mitsuba run wrote
 //!   (per pixel: the normal and the view, six f32), bakes `<slug>.exr` with the defaults
-//!   and writes `DIR/<slug>_r<r>_k<K>.f32`: per pixel the RGB that splitsum's shading gives a
-//!   white metal of roughness `r` with `K` fetches (the one fetch is the default), and at
-//!   every [`STRIDE`]-th pixel the exact reflectance integral of the same metal over the
-//!   baked source cube (`splitsum_reference::Environment::shade`), with the glTF BRDF's
-//!   height-correlated masking (`<slug>_r<r>_exact_correlated.f32`) and with Mitsuba's
-//!   separable one (`_exact_separable.f32`): which of the two Mitsuba renders, and how far
-//!   apart they are.
+//!   and writes `DIR/<slug>_<material>_r<r>_k<K>.f32`: per pixel the RGB that splitsum's
+//!   shading gives the material ([`MATERIALS`]) at roughness `r` with `K` fetches (the one
+//!   fetch is the default), and at every [`STRIDE`]-th pixel the exact reflectance integral
+//!   of the glTF BRDF over the baked source cube (`splitsum_reference::Environment::shade`,
+//!   height-correlated masking: `<slug>_<material>_r<r>_exact.f32`), which checks the
+//!   Mitsuba renders before they are compared with.
 use splitsum::Product;
 use splitsum::backend::{Backend, BackendKind};
 use splitsum::settings::Settings;
@@ -30,6 +30,9 @@ const ROUGHNESS: [f32; 5] = [0.3, 0.5, 0.65, 0.8, 1.0];
 const FETCHES: [u32; 3] = [1, 4, 16];
 /// Every how many pixels the exact integrals are computed (each a sum over the source cube).
 const STRIDE: usize = 16;
+/// The materials (`scripts/mitsuba_spheres.py`'s `MATERIALS`, the same): name, metallic,
+/// base colour.
+const MATERIALS: [(&str, f32, [f32; 3]); 2] = [("metal", 1.0, [1.0; 3]), ("dielectric", 0.0, [0.9, 0.6, 0.3])];
 
 fn slug(name: &str) -> String {
     name.chars().map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '_' }).collect()
@@ -71,10 +74,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let exact = reference::Environment::new(source.level(0), source.layout.size);
                 let shape = baked.shape();
                 let specular = baked.specular_buffer();
-                for &r in &ROUGHNESS {
+                for ((material, metallic, base), &r) in MATERIALS.iter().flat_map(|m| ROUGHNESS.iter().map(move |r| (*m, r))) {
                     let m = Material {
-                        base_color: Vec3::ONE,
-                        metallic: 1.0,
+                        base_color: Vec3::from_array(base),
+                        metallic,
                         roughness: r,
                         occlusion: 1.0,
                         emissive: Vec3::ZERO,
@@ -100,20 +103,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                             out.extend([c.x, c.y, c.z]);
                         }
                         let bytes: Vec<u8> = out.iter().flat_map(|x| x.to_le_bytes()).collect();
-                        std::fs::write(dir.join(format!("{s}_r{r}_k{k}.f32")), bytes)?;
+                        std::fs::write(dir.join(format!("{s}_{material}_r{r}_k{k}.f32")), bytes)?;
                     }
                     let picked: Vec<&[f32]> = raw.chunks_exact(6).step_by(STRIDE).collect();
-                    for (smith, name) in [(reference::Smith::Correlated, "correlated"), (reference::Smith::Separable, "separable")] {
-                        let out: Vec<f32> = picked
-                            .par_iter()
-                            .flat_map_iter(|p| {
-                                let (n, v) = ([p[0] as f64, p[1] as f64, p[2] as f64], [p[3] as f64, p[4] as f64, p[5] as f64]);
-                                exact.shade(n, v, [1.0; 3], 1.0, r as f64, smith).map(|c| c as f32)
-                            })
-                            .collect();
-                        let bytes: Vec<u8> = out.iter().flat_map(|x| x.to_le_bytes()).collect();
-                        std::fs::write(dir.join(format!("{s}_r{r}_exact_{name}.f32")), bytes)?;
-                    }
+                    let out: Vec<f32> = picked
+                        .par_iter()
+                        .flat_map_iter(|p| {
+                            let (n, v) = ([p[0] as f64, p[1] as f64, p[2] as f64], [p[3] as f64, p[4] as f64, p[5] as f64]);
+                            exact.shade(n, v, base.map(f64::from), metallic as f64, r as f64, reference::Smith::Correlated).map(|c| c as f32)
+                        })
+                        .collect();
+                    let bytes: Vec<u8> = out.iter().flat_map(|x| x.to_le_bytes()).collect();
+                    std::fs::write(dir.join(format!("{s}_{material}_r{r}_exact.f32")), bytes)?;
                 }
                 eprintln!("shaded {s}");
             }
