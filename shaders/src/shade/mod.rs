@@ -35,7 +35,7 @@
 //! on top, `L_o = sheen + base·(1 − max(c)·E_C)` ([`sheen_ibl`], [`sheen_direct`]).
 
 mod ladder;
-pub use ladder::{FETCH_HORIZON_LIFT, LADDER_BLEND, LADDER_CROSSOVER, LADDER_RUNGS, MAX_FETCHES, ladder_weight, lobe_radiance, spiral_radius2};
+pub use ladder::{LADDER_BLEND, LADDER_CROSSOVER, LADDER_RUNGS, MAX_FETCHES, ladder_weight, lobe_radiance, spiral_radius2};
 mod read_split;
 pub use read_split::{excess_irradiance, excess_lobe_radiance};
 
@@ -467,18 +467,10 @@ pub const HORIZON_LIFT: f32 = 0.75;
 /// direction lower than `θ` above the horizon is turned up, in the plane of `n` and `d`, to
 /// `θ`; one higher is left as it is, and `k ≥ 1` (a lobe of a hemisphere) reads along `n`.
 /// Turning the direction instead of darkening the read keeps a constant environment exact.
-#[inline]
-pub fn above_horizon(n: Vec3, d: Vec3, roughness: f32) -> Vec3 {
-    above_horizon_by(n, d, roughness, HORIZON_LIFT)
-}
-
-/// [`above_horizon`] with `lift` in place of [`HORIZON_LIFT`]: the read direction `d` turned
-/// up so that the cone of `lift` times the median half-angle of the lobe of `roughness`
-/// round it stays above the horizon of `n`.
 #[cfg_attr(target_arch = "spirv", inline(never))]
 #[cfg_attr(not(target_arch = "spirv"), inline)]
-pub fn above_horizon_by(n: Vec3, d: Vec3, roughness: f32, lift: f32) -> Vec3 {
-    let k = lift * alpha_from_roughness(math::saturate(roughness));
+pub fn above_horizon(n: Vec3, d: Vec3, roughness: f32) -> Vec3 {
+    let k = HORIZON_LIFT * alpha_from_roughness(math::saturate(roughness));
     if k >= 1.0 {
         return n;
     }
