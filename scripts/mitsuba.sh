@@ -18,7 +18,7 @@ fi
 # SPLITSUM_DRY_RUN: print the commands instead of running them (as scripts/dev.sh does).
 dry() { [ -n "${SPLITSUM_DRY_RUN:-}" ]; }
 run() { if dry; then printf 'dry-run:'; printf ' %q' "$@"; echo; return 0; fi; "$@"; }
-SPP=${1:-256}
+SPP=${1:-1024}
 RES=${2:-64}
 run bash scripts/dev.sh environments >&2
 VENV=target/mitsuba-venv
