@@ -294,8 +294,9 @@ case "$cmd" in
             --processes 3 --versus "$ggx" --versus "$lambertian" --versus "$charlie" --figures book/src/figures/speed-sheen.md
         run "$inputs" sky target/figures/16k.exr 16384
         run "$runner" bench target/figures/16k.exr --backends cpu --processes 3 --figures book/src/figures/memory.md
-        # Rough-metal spheres against Mitsuba 3's path tracer (installs it from PyPI into
-        # target/mitsuba-venv; under a minute once installed).
+        # Metal and dielectric spheres against Mitsuba 3's path tracer with the glTF BRDF
+        # (installs it from PyPI into target/mitsuba-venv, and libllvm19 where the system's
+        # LLVM is older than 16).
         run bash scripts/mitsuba.sh --figure book/src/figures/mitsuba.md
         # What the tests measure against the peers and the exact references, written by
         # the tests themselves where SPLITSUM_FIGURES is set (tests/support/figure.rs).
