@@ -11,10 +11,14 @@ use splitsum::measured::{Method, Part, Quantity};
 use splitsum::settings::Settings;
 use std::fmt::Write;
 
-/// The methods of the headline: what a user bakes by default, the ladder's top rung, and
-/// the seed's method (the Khronos glTF-IBL-Sampler's settings: sampled, 1024 samples).
-const LINES: [(&str, Method, u32, Option<u32>); 3] = [
+/// The methods of the headline: what a user bakes by default, read with each rung of the
+/// shading ladder (the README's rung table), and the seed's method (the Khronos
+/// glTF-IBL-Sampler's settings: sampled, 1024 samples).
+const LINES: [(&str, Method, u32, Option<u32>); 6] = [
     ("defaults (one fetch)", Method::Defaults, 1, None),
+    ("defaults, 2 fetches (`--fetches 2`)", Method::Ladder, 2, None),
+    ("defaults, 4 fetches (`--fetches 4`)", Method::Ladder, 4, None),
+    ("defaults, 8 fetches (`--fetches 8`)", Method::Ladder, 8, None),
     ("defaults, 16 fetches (`--fetches 16`)", Method::Ladder, 16, None),
     ("seed: sampled, 1024 samples (glTF-IBL-Sampler's settings)", Method::Seed, 1, Some(1024)),
 ];
@@ -44,8 +48,8 @@ pub fn set_mean(rows: &[Measurement], set: Set, method: Method, fetches: u32, sa
     (!errors.is_empty()).then(|| errors.iter().sum::<f64>() / errors.len() as f64)
 }
 
-/// The headline table: a row per method (the defaults, 16 fetches, the seed's settings), a
-/// column per set and `n·v` band;
+/// The headline table: a row per method (the defaults at each rung of the ladder, the
+/// seed's settings), a column per set and `n·v` band;
 /// `None` where the report measured no set.
 pub fn headline_table(rows: &[Measurement]) -> Option<(Vec<String>, Vec<Vec<String>>)> {
     if !rows.iter().any(|r| r.set.is_some()) {
