@@ -118,7 +118,7 @@ fn a_constant_sky_shades_exactly_at_the_extremes() {
 /// Suns of 10⁴ and 10⁶ 1–15° below the horizon of rough metals at grazing views
 /// (`splitsum_report::horizon`): what each rung of the shading ladder lets back in, on the
 /// CPU at a 64² source, printed for the README's table. Asserted: every rung's error under
-/// the sky alone within 15 % (measured 1.6–2.5 %: the points are grazing views, n·v
+/// the sky alone within 15 % (measured 1.1–2.5 %: the points are grazing views, n·v
 /// 0.1–0.5), so that the printed difference is the sun's; and what the sun adds to the mean
 /// at most 10 points at every rung (issue 34's target; measured −0.1 to +2.3).
 #[test]

@@ -24,7 +24,7 @@ use rayon::prelude::*;
 use splitsum_reference as reference;
 use std::path::Path;
 
-/// The roughnesses rendered (rough metals, r 0.3–1).
+/// The roughnesses rendered (r 0.3–1), of each material.
 const ROUGHNESS: [f32; 5] = [0.3, 0.5, 0.65, 0.8, 1.0];
 /// The ladder's rungs compared.
 const FETCHES: [u32; 3] = [1, 4, 16];
@@ -74,6 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let exact = reference::Environment::new(source.level(0), source.layout.size);
                 let shape = baked.shape();
                 let specular = baked.specular_buffer();
+                let (irradiance, table) = (&baked.cube(Product::Irradiance).texels, &baked.table(Product::BrdfTable).texels);
                 for ((material, metallic, base), &r) in MATERIALS.iter().flat_map(|m| ROUGHNESS.iter().map(move |r| (*m, r))) {
                     let m = Material {
                         base_color: Vec3::from_array(base),
@@ -89,16 +90,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         let mut out = Vec::with_capacity(raw.len() / 2);
                         for p in raw.chunks_exact(6) {
                             let (n, v) = (Vec3::new(p[0], p[1], p[2]), Vec3::new(p[3], p[4], p[5]));
-                            let sample = shade::ibl_sample(
-                                shape,
-                                &specular,
-                                &baked.cube(Product::Irradiance).texels,
-                                &baked.table(Product::BrdfTable).texels,
-                                opts,
-                                &m,
-                                n,
-                                v,
-                            );
+                            let sample = shade::ibl_sample(shape, &specular, irradiance, table, opts, &m, n, v);
                             let c = shade::ibl(opts, &m, n, v, sample);
                             out.extend([c.x, c.y, c.z]);
                         }
